@@ -1,0 +1,53 @@
+//! Geometric vocabulary: the point type and the exact predicates every topological decision uses.
+
+pub mod predicates;
+
+/// Every coordinate in blmesh is an `f64` 3-vector.
+pub type Point = glam::DVec3;
+pub use glam::DVec3;
+
+/// Axis-aligned bounding box.
+#[derive(Clone, Copy, Debug, PartialEq, serde::Serialize)]
+pub struct Aabb {
+    pub min: DVec3,
+    pub max: DVec3,
+}
+
+impl Aabb {
+    /// The empty box (min = +inf, max = -inf); growing it by any point gives that point.
+    pub fn empty() -> Self {
+        Aabb { min: DVec3::splat(f64::INFINITY), max: DVec3::splat(f64::NEG_INFINITY) }
+    }
+
+    pub fn from_points<'a>(points: impl IntoIterator<Item = &'a DVec3>) -> Self {
+        let mut b = Aabb::empty();
+        for p in points {
+            b.grow(*p);
+        }
+        b
+    }
+
+    pub fn grow(&mut self, p: DVec3) {
+        self.min = self.min.min(p);
+        self.max = self.max.max(p);
+    }
+
+    pub fn diagonal(&self) -> f64 {
+        (self.max - self.min).length()
+    }
+
+    pub fn center(&self) -> DVec3 {
+        0.5 * (self.min + self.max)
+    }
+}
+
+/// Twice the signed area vector of triangle (a, b, c): its direction is the right-hand normal.
+pub fn triangle_area_vector(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
+    (b - a).cross(c - a)
+}
+
+/// Signed volume of tetrahedron (a, b, c, d): positive when d lies on the side the right-hand
+/// normal of (a, b, c) points to (the Gmsh/VTK convention for a valid tetrahedron).
+pub fn tet_signed_volume(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
+    (b - a).cross(c - a).dot(d - a) / 6.0
+}

@@ -1,0 +1,220 @@
+//! Reading surfaces and volume meshes, writing volume meshes.
+//!
+//! Every parser works on bytes in memory (`parse(&[u8])`) so that tests and fuzzers need no files;
+//! [`read_surface`] and [`read_volume_mesh`] add the file name to errors. Every writer goes through
+//! [`write_atomic`], so a failed run never leaves a half-written output file.
+
+pub mod cart3d;
+pub mod medit;
+pub mod msh;
+pub mod obj;
+pub mod off;
+pub mod stl;
+pub mod uh3d;
+pub mod vtu;
+
+use std::fmt;
+use std::io::Write;
+use std::path::{Path, PathBuf};
+
+use crate::mesh::VolumeMesh;
+use crate::surface::Surface;
+
+/// Where in a file a parse error is.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Location {
+    /// 1-based line number of a text file.
+    Line(usize),
+    /// Byte offset in a binary file.
+    Byte(u64),
+    /// The file as a whole (e.g. it is empty).
+    File,
+}
+
+/// A malformed or truncated file: what is wrong and where.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct ParseError {
+    pub at: Location,
+    pub message: String,
+}
+
+impl ParseError {
+    pub fn at_line(line: usize, message: impl Into<String>) -> Self {
+        ParseError { at: Location::Line(line), message: message.into() }
+    }
+    pub fn at_byte(offset: u64, message: impl Into<String>) -> Self {
+        ParseError { at: Location::Byte(offset), message: message.into() }
+    }
+    pub fn file(message: impl Into<String>) -> Self {
+        ParseError { at: Location::File, message: message.into() }
+    }
+}
+
+impl fmt::Display for ParseError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match self.at {
+            Location::Line(l) => write!(f, "line {l}: {}", self.message),
+            Location::Byte(b) => write!(f, "byte {b}: {}", self.message),
+            Location::File => write!(f, "{}", self.message),
+        }
+    }
+}
+
+impl std::error::Error for ParseError {}
+
+/// Reading a file failed.
+#[derive(Debug, thiserror::Error)]
+pub enum ReadError {
+    #[error("{}: cannot read: {source}", path.display())]
+    Io { path: PathBuf, source: std::io::Error },
+    #[error("{}: {source}", path.display())]
+    Parse { path: PathBuf, source: ParseError },
+    #[error("{}: unknown file type (expected {expected})", path.display())]
+    UnknownFormat { path: PathBuf, expected: &'static str },
+}
+
+/// Surface formats, chosen by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum SurfaceFormat {
+    Stl,
+    Obj,
+    Off,
+    Msh,
+    MeditAscii,
+    MeditBinary,
+    Cart3d,
+    Uh3d,
+}
+
+const SURFACE_EXTENSIONS: &str = ".stl, .obj, .off, .msh, .mesh, .meshb, .tri, .uh3d";
+
+impl SurfaceFormat {
+    pub fn from_path(path: &Path) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        Some(match ext.as_str() {
+            "stl" => SurfaceFormat::Stl,
+            "obj" => SurfaceFormat::Obj,
+            "off" => SurfaceFormat::Off,
+            "msh" => SurfaceFormat::Msh,
+            "mesh" => SurfaceFormat::MeditAscii,
+            "meshb" => SurfaceFormat::MeditBinary,
+            "tri" => SurfaceFormat::Cart3d,
+            "uh3d" => SurfaceFormat::Uh3d,
+            _ => return None,
+        })
+    }
+
+    /// Parse a surface of this format from bytes.
+    pub fn parse(self, bytes: &[u8]) -> Result<Surface, ParseError> {
+        match self {
+            SurfaceFormat::Stl => stl::parse(bytes),
+            SurfaceFormat::Obj => obj::parse(bytes),
+            SurfaceFormat::Off => off::parse(bytes),
+            SurfaceFormat::Msh => msh::parse_surface(bytes),
+            SurfaceFormat::MeditAscii | SurfaceFormat::MeditBinary => medit::parse_surface(bytes),
+            SurfaceFormat::Cart3d => cart3d::parse(bytes),
+            SurfaceFormat::Uh3d => uh3d::parse(bytes),
+        }
+    }
+}
+
+fn read_bytes(path: &Path) -> Result<Vec<u8>, ReadError> {
+    std::fs::read(path).map_err(|source| ReadError::Io { path: path.to_owned(), source })
+}
+
+/// Read a triangle surface with patch names; the format is chosen by the file extension.
+pub fn read_surface(path: &Path) -> Result<Surface, ReadError> {
+    let format = SurfaceFormat::from_path(path).ok_or_else(|| ReadError::UnknownFormat {
+        path: path.to_owned(),
+        expected: SURFACE_EXTENSIONS,
+    })?;
+    let bytes = read_bytes(path)?;
+    format.parse(&bytes).map_err(|source| ReadError::Parse { path: path.to_owned(), source })
+}
+
+/// Read a volume mesh (`.msh` Gmsh 4.1/2.2, `.vtu`).
+pub fn read_volume_mesh(path: &Path) -> Result<VolumeMesh, ReadError> {
+    let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
+    let parse: fn(&[u8]) -> Result<VolumeMesh, ParseError> = match ext.as_deref() {
+        Some("msh") => msh::parse_volume,
+        Some("vtu") => vtu::parse,
+        _ => {
+            return Err(ReadError::UnknownFormat { path: path.to_owned(), expected: ".msh, .vtu" })
+        }
+    };
+    let bytes = read_bytes(path)?;
+    parse(&bytes).map_err(|source| ReadError::Parse { path: path.to_owned(), source })
+}
+
+/// Volume mesh output formats, chosen by file extension.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum MeshFormat {
+    /// Gmsh MSH 4.1 (binary unless `ascii`).
+    Msh { ascii: bool },
+    Vtu,
+}
+
+impl MeshFormat {
+    pub fn from_path(path: &Path, ascii: bool) -> Option<Self> {
+        let ext = path.extension()?.to_str()?.to_ascii_lowercase();
+        match ext.as_str() {
+            "msh" => Some(MeshFormat::Msh { ascii }),
+            "vtu" => Some(MeshFormat::Vtu),
+            _ => None,
+        }
+    }
+}
+
+/// Write a volume mesh atomically in the given format.
+pub fn write_volume_mesh(path: &Path, mesh: &VolumeMesh, format: MeshFormat) -> std::io::Result<()> {
+    write_atomic(path, |w| match format {
+        MeshFormat::Msh { ascii } => msh::write(w, mesh, ascii),
+        MeshFormat::Vtu => vtu::write(w, mesh),
+    })
+}
+
+/// Write a file through a temporary in the same directory, renamed over `path` only when
+/// `write` succeeded: readers never see a half-written file, and a failure leaves no file.
+pub fn write_atomic(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let dir = match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    };
+    let mut tmp = tempfile::Builder::new().prefix(".blmesh-").tempfile_in(dir)?;
+    {
+        let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
+        write(&mut buffered)?;
+        buffered.flush()?;
+    }
+    tmp.as_file().sync_all()?;
+    tmp.persist(path).map_err(|e| e.error)?;
+    Ok(())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn atomic_write_leaves_nothing_on_failure() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out.txt");
+        let r = write_atomic(&path, |w| {
+            w.write_all(b"partial")?;
+            Err(std::io::Error::other("boom"))
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
+        write_atomic(&path, |w| w.write_all(b"whole")).unwrap();
+        assert_eq!(std::fs::read(&path).unwrap(), b"whole");
+    }
+
+    #[test]
+    fn unknown_extension_is_a_clear_error() {
+        let e = read_surface(Path::new("body.xyz")).unwrap_err();
+        assert!(e.to_string().contains("unknown file type"), "{e}");
+    }
+}

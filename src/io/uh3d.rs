@@ -1,0 +1,8 @@
+//! uh3d surface reader (to be written).
+
+use super::ParseError;
+use crate::surface::Surface;
+
+pub fn parse(_bytes: &[u8]) -> Result<Surface, ParseError> {
+    Err(ParseError::file("uh3d reader not written yet"))
+}

@@ -1,0 +1,18 @@
+//! blmesh: boundary-layer volume meshes for CFD.
+//!
+//! The crate follows the pipeline of `DESIGN.md`, one module per stage, data flowing one way:
+//!
+//! ```text
+//! io (read surface) -> surface::validate -> surface::features -> normals -> sizing
+//!    -> layers -> fill -> quality (check) -> io (write mesh + report)
+//! ```
+//!
+//! Shared vocabulary lives in [`geometry`] (points, exact predicates), [`surface`] (the input
+//! triangle surface with named patches) and [`mesh`] (the hybrid volume mesh and its node orders).
+
+pub mod cli;
+pub mod geometry;
+pub mod io;
+pub mod mesh;
+pub mod quality;
+pub mod surface;

@@ -1,0 +1,197 @@
+//! The hybrid volume mesh: points, cells of four kinds, boundary faces with patch ids.
+//!
+//! # Node orders (the one place they are defined)
+//! Cells use the Gmsh order, which is also meshio's; a cell is valid when every tetrahedron of
+//! its decomposition has positive volume ([`crate::geometry::tet_signed_volume`] > 0).
+//!
+//! ```text
+//! Tetrahedron  0 1 2 3      (0,1,2) is counter-clockwise seen from 3: its right-hand normal points to 3.
+//! Pyramid      0 1 2 3 | 4  base quad (0,1,2,3), right-hand normal pointing to the apex 4.
+//! Prism        0 1 2 | 3 4 5  bottom (0,1,2) with right-hand normal pointing to the top;
+//!              lateral edges 0-3, 1-4, 2-5.
+//! Hexahedron   0 1 2 3 | 4 5 6 7  bottom quad with right-hand normal pointing to the top;
+//!              lateral edges 0-4, 1-5, 2-6, 3-7.
+//! ```
+//! VTK uses the same orders except the prism (VTK_WEDGE), whose bottom normal points away from the
+//! top: VTK wedge = Gmsh prism permuted by [`CellKind::vtk_permutation`].
+//!
+//! Faces of each kind, oriented outward, are in [`CellKind::faces`].
+
+use crate::geometry::DVec3;
+
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CellKind {
+    Tetrahedron,
+    Pyramid,
+    Prism,
+    Hexahedron,
+}
+
+/// A face of a reference cell, as local node indices, oriented outward.
+pub type LocalFace = &'static [usize];
+
+impl CellKind {
+    pub const ALL: [CellKind; 4] =
+        [CellKind::Tetrahedron, CellKind::Pyramid, CellKind::Prism, CellKind::Hexahedron];
+
+    pub fn node_count(self) -> usize {
+        match self {
+            CellKind::Tetrahedron => 4,
+            CellKind::Pyramid => 5,
+            CellKind::Prism => 6,
+            CellKind::Hexahedron => 8,
+        }
+    }
+
+    /// Outward-oriented faces (right-hand normal points out of the cell).
+    pub fn faces(self) -> &'static [LocalFace] {
+        match self {
+            CellKind::Tetrahedron => &[&[0, 2, 1], &[0, 1, 3], &[1, 2, 3], &[0, 3, 2]],
+            CellKind::Pyramid => &[&[0, 3, 2, 1], &[0, 1, 4], &[1, 2, 4], &[2, 3, 4], &[3, 0, 4]],
+            CellKind::Prism => {
+                &[&[0, 2, 1], &[3, 4, 5], &[0, 1, 4, 3], &[1, 2, 5, 4], &[2, 0, 3, 5]]
+            }
+            CellKind::Hexahedron => &[
+                &[0, 3, 2, 1],
+                &[4, 5, 6, 7],
+                &[0, 1, 5, 4],
+                &[1, 2, 6, 5],
+                &[2, 3, 7, 6],
+                &[3, 0, 4, 7],
+            ],
+        }
+    }
+
+    /// Gmsh element type number (first order).
+    pub fn gmsh_type(self) -> i32 {
+        match self {
+            CellKind::Tetrahedron => 4,
+            CellKind::Pyramid => 7,
+            CellKind::Prism => 6,
+            CellKind::Hexahedron => 5,
+        }
+    }
+
+    /// VTK cell type number.
+    pub fn vtk_type(self) -> u8 {
+        match self {
+            CellKind::Tetrahedron => 10,
+            CellKind::Pyramid => 14,
+            CellKind::Prism => 13,
+            CellKind::Hexahedron => 12,
+        }
+    }
+
+    /// `vtk_nodes[i] = gmsh_nodes[perm[i]]`; the permutation is an involution.
+    pub fn vtk_permutation(self) -> &'static [usize] {
+        match self {
+            CellKind::Tetrahedron => &[0, 1, 2, 3],
+            CellKind::Pyramid => &[0, 1, 2, 3, 4],
+            CellKind::Prism => &[0, 2, 1, 3, 5, 4],
+            CellKind::Hexahedron => &[0, 1, 2, 3, 4, 5, 6, 7],
+        }
+    }
+
+    pub fn name(self) -> &'static str {
+        match self {
+            CellKind::Tetrahedron => "tetrahedron",
+            CellKind::Pyramid => "pyramid",
+            CellKind::Prism => "prism",
+            CellKind::Hexahedron => "hexahedron",
+        }
+    }
+}
+
+/// One block of cells of a single kind; `nodes` holds `kind.node_count()` indices per cell.
+#[derive(Clone, Debug)]
+pub struct CellBlock {
+    pub kind: CellKind,
+    pub nodes: Vec<u32>,
+    /// Volume zone of every cell (index into [`VolumeMesh::zone_names`]).
+    pub zone: Vec<u32>,
+}
+
+impl CellBlock {
+    pub fn new(kind: CellKind) -> Self {
+        CellBlock { kind, nodes: Vec::new(), zone: Vec::new() }
+    }
+
+    pub fn len(&self) -> usize {
+        self.zone.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.zone.is_empty()
+    }
+
+    pub fn cell(&self, i: usize) -> &[u32] {
+        let n = self.kind.node_count();
+        &self.nodes[i * n..(i + 1) * n]
+    }
+
+    pub fn push(&mut self, nodes: &[u32], zone: u32) {
+        debug_assert_eq!(nodes.len(), self.kind.node_count());
+        self.nodes.extend_from_slice(nodes);
+        self.zone.push(zone);
+    }
+
+    pub fn iter(&self) -> impl Iterator<Item = &[u32]> {
+        self.nodes.chunks_exact(self.kind.node_count())
+    }
+}
+
+/// Boundary faces (triangles or quads) with the patch of each, oriented out of the domain.
+#[derive(Clone, Debug, Default)]
+pub struct BoundaryFaces {
+    pub triangles: Vec<[u32; 3]>,
+    pub triangle_patch: Vec<u32>,
+    pub quads: Vec<[u32; 4]>,
+    pub quad_patch: Vec<u32>,
+}
+
+/// A hybrid volume mesh.
+#[derive(Clone, Debug)]
+pub struct VolumeMesh {
+    pub points: Vec<DVec3>,
+    /// One block per kind, in [`CellKind::ALL`] order.
+    pub blocks: [CellBlock; 4],
+    pub zone_names: Vec<String>,
+    pub boundary: BoundaryFaces,
+    pub patch_names: Vec<String>,
+}
+
+impl Default for VolumeMesh {
+    fn default() -> Self {
+        VolumeMesh {
+            points: Vec::new(),
+            blocks: CellKind::ALL.map(CellBlock::new),
+            zone_names: Vec::new(),
+            boundary: BoundaryFaces::default(),
+            patch_names: Vec::new(),
+        }
+    }
+}
+
+impl VolumeMesh {
+    pub fn block(&self, kind: CellKind) -> &CellBlock {
+        &self.blocks[kind as usize]
+    }
+
+    pub fn block_mut(&mut self, kind: CellKind) -> &mut CellBlock {
+        &mut self.blocks[kind as usize]
+    }
+
+    pub fn push_cell(&mut self, kind: CellKind, nodes: &[u32], zone: u32) {
+        self.block_mut(kind).push(nodes, zone);
+    }
+
+    pub fn cell_count(&self) -> usize {
+        self.blocks.iter().map(CellBlock::len).sum()
+    }
+
+    /// Every cell as (kind, nodes), block by block.
+    pub fn cells(&self) -> impl Iterator<Item = (CellKind, &[u32])> {
+        self.blocks.iter().flat_map(|b| b.iter().map(move |c| (b.kind, c)))
+    }
+}

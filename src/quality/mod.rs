@@ -1,0 +1,1 @@
+//! Volume-mesh checker: the oracle every test uses (to be written).
