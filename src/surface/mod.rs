@@ -5,6 +5,8 @@
 //! positive enclosed volume (normals point into the fluid for an external body), no triangle is
 //! degenerate and no two triangles intersect except at shared edges/vertices.
 
+use std::collections::HashMap;
+
 use crate::geometry::{triangle_area_vector, Aabb, DVec3};
 
 /// A triangle surface: points, triangles (counter-clockwise seen from the fluid, so the
@@ -63,5 +65,88 @@ impl Surface {
         for t in &mut self.triangles {
             t.swap(1, 2);
         }
+    }
+
+    /// Drop the points no triangle uses and renumber the rest (order kept), so that every
+    /// point is a triangle vertex. Triangle indices must be in range.
+    pub fn remove_unused_points(&mut self) {
+        let mut used = vec![false; self.points.len()];
+        for &v in self.triangles.iter().flatten() {
+            used[v as usize] = true;
+        }
+        let mut new_index = vec![u32::MAX; self.points.len()];
+        let mut points = Vec::with_capacity(self.points.len());
+        for (i, &p) in self.points.iter().enumerate() {
+            if used[i] {
+                new_index[i] = points.len() as u32;
+                points.push(p);
+            }
+        }
+        self.points = points;
+        self.renumber_triangles(&new_index);
+    }
+
+    /// Merge points with bit-identical coordinates (-0.0 counts as 0.0), keeping the first
+    /// occurrence's position in the order. Used where a format repeats shared vertices (STL).
+    pub fn weld_exact(&mut self) {
+        let mut index_of: HashMap<[u64; 3], u32> = HashMap::with_capacity(self.points.len());
+        let mut points = Vec::with_capacity(self.points.len());
+        let new_index: Vec<u32> = self
+            .points
+            .iter()
+            .map(|&p| {
+                // Adding +0.0 maps -0.0 to +0.0 and leaves every other value (and NaN bits) alone.
+                let key = (p + DVec3::ZERO).to_array().map(f64::to_bits);
+                *index_of.entry(key).or_insert_with(|| {
+                    points.push(p + DVec3::ZERO);
+                    (points.len() - 1) as u32
+                })
+            })
+            .collect();
+        self.points = points;
+        self.renumber_triangles(&new_index);
+    }
+
+    fn renumber_triangles(&mut self, new_index: &[u32]) {
+        for t in &mut self.triangles {
+            *t = t.map(|v| new_index[v as usize]);
+        }
+    }
+
+    /// Set the patches from one integer label per triangle (Cart3D component, Medit reference,
+    /// UH3D component): one patch per distinct label, in increasing label order, named by `name`.
+    pub fn set_patches_from_labels(&mut self, labels: &[i64], name: impl Fn(i64) -> String) {
+        let mut distinct = labels.to_vec();
+        distinct.sort_unstable();
+        distinct.dedup();
+        let index_of: HashMap<i64, u32> =
+            distinct.iter().enumerate().map(|(i, &label)| (label, i as u32)).collect();
+        self.triangle_patch = labels.iter().map(|label| index_of[label]).collect();
+        self.patch_names = distinct.into_iter().map(name).collect();
+    }
+}
+
+/// Patch names met while reading a file (STL solids, OBJ groups), each given an index once,
+/// in order of first use; a name met again gets its earlier index.
+#[derive(Clone, Debug, Default)]
+pub struct PatchTable {
+    index_of: HashMap<String, u32>,
+    names: Vec<String>,
+}
+
+impl PatchTable {
+    /// The index of patch `name`, a new one if the name is new.
+    pub fn index(&mut self, name: &str) -> u32 {
+        if let Some(&i) = self.index_of.get(name) {
+            return i;
+        }
+        let i = self.names.len() as u32;
+        self.index_of.insert(name.to_owned(), i);
+        self.names.push(name.to_owned());
+        i
+    }
+
+    pub fn into_names(self) -> Vec<String> {
+        self.names
     }
 }
