@@ -114,15 +114,17 @@ impl Surface {
     }
 
     /// Set the patches from one integer label per triangle (Cart3D component, Medit reference,
-    /// UH3D component): one patch per distinct label, in increasing label order, named by `name`.
+    /// UH3D component): one patch per distinct label, in increasing label order, named by
+    /// `name`; labels given the same name share a patch.
     pub fn set_patches_from_labels(&mut self, labels: &[i64], name: impl Fn(i64) -> String) {
         let mut distinct = labels.to_vec();
         distinct.sort_unstable();
         distinct.dedup();
-        let index_of: HashMap<i64, u32> =
-            distinct.iter().enumerate().map(|(i, &label)| (label, i as u32)).collect();
-        self.triangle_patch = labels.iter().map(|label| index_of[label]).collect();
-        self.patch_names = distinct.into_iter().map(name).collect();
+        let mut table = PatchTable::default();
+        let patch_of: HashMap<i64, u32> =
+            distinct.into_iter().map(|label| (label, table.index(&name(label)))).collect();
+        self.triangle_patch = labels.iter().map(|label| patch_of[label]).collect();
+        self.patch_names = table.into_names();
     }
 }
 
@@ -148,5 +150,54 @@ impl PatchTable {
 
     pub fn into_names(self) -> Vec<String> {
         self.names
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn soup() -> Surface {
+        Surface {
+            points: vec![DVec3::X, DVec3::new(9.0, 9.0, 9.0), DVec3::ZERO, DVec3::X, DVec3::new(-0.0, 0.0, 0.0)],
+            triangles: vec![[0, 2, 3], [3, 4, 0]],
+            triangle_patch: vec![0, 0],
+            patch_names: vec!["wall".into()],
+        }
+    }
+
+    #[test]
+    fn unused_points_are_dropped_in_order() {
+        let mut s = soup();
+        s.remove_unused_points();
+        assert_eq!(s.points, vec![DVec3::X, DVec3::ZERO, DVec3::X, DVec3::ZERO]);
+        assert_eq!(s.triangles, vec![[0, 1, 2], [2, 3, 0]]);
+    }
+
+    #[test]
+    fn exact_weld_merges_equal_bits_and_signed_zeros() {
+        let mut s = soup();
+        s.weld_exact();
+        s.remove_unused_points();
+        assert_eq!(s.points, vec![DVec3::X, DVec3::ZERO]);
+        assert!(!s.points[1].x.is_sign_negative());
+        assert_eq!(s.triangles, vec![[0, 1, 0], [0, 1, 0]]);
+        let mut nearly = soup();
+        nearly.points[3].x = 1.0 + f64::EPSILON;
+        nearly.weld_exact();
+        assert_eq!(nearly.points.len(), 4, "only bit-identical points merge");
+    }
+
+    #[test]
+    fn labels_become_patches_in_increasing_order_and_names_merge() {
+        let mut s = soup();
+        s.set_patches_from_labels(&[7, -2], |l| format!("ref_{l}"));
+        assert_eq!(s.patch_names, vec!["ref_-2", "ref_7"]);
+        assert_eq!(s.triangle_patch, vec![1, 0]);
+        s.set_patches_from_labels(&[7, -2], |_| "same".into());
+        assert_eq!((s.patch_names.len(), s.triangle_patch.clone()), (1, vec![0, 0]));
+        let mut table = PatchTable::default();
+        assert_eq!([table.index("b"), table.index("a"), table.index("b")], [0, 1, 0]);
+        assert_eq!(table.into_names(), vec!["b", "a"]);
     }
 }
