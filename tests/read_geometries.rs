@@ -105,9 +105,8 @@ fn medit_ascii_and_binary_round_trip_every_geometry() {
             let mut bytes = Vec::new();
             medit::write_surface(&mut bytes, &s, binary).unwrap();
             let back = medit::parse_surface(&bytes).unwrap_or_else(|e| panic!("{name}: {e}"));
-            let bits = |s: &Surface| {
-                s.points.iter().map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>()
-            };
+            let bits =
+                |s: &Surface| s.points.iter().map(|p| p.to_array().map(f64::to_bits)).collect::<Vec<_>>();
             assert!(bits(&back) == bits(&s), "{name} (binary: {binary}): points differ");
             assert!(back.triangles == s.triangles, "{name} (binary: {binary}): triangles differ");
             assert!(back.triangle_patch == s.triangle_patch, "{name} (binary: {binary}): patches");

@@ -1,6 +1,6 @@
 //! Medit / libMeshb surfaces: `.mesh` (ASCII) and `.meshb` (binary), read and written.
 //!
-//! Only `Dimension` (3), `Vertices`, `Triangles` and `Quadrilaterals` (split in two triangles)
+//! Only `Dimension` (3, assumed when absent), `Vertices`, `Triangles` and `Quadrilaterals` (split in two triangles)
 //! are read; every other section is skipped. Each element reference becomes patch `ref_<n>`.
 //! ASCII keywords are case-insensitive and found wherever they are, as libMeshb does.
 //! Binary files start with the integer 1 (its byte order gives the file's), then the version:
@@ -136,19 +136,19 @@ impl<S> Sections<S> {
         Sections { dimension: None, vertices: None, triangles: None, quadrilaterals: None }
     }
 
-    /// Record section `code` starting at `source`; false for codes not read.
-    fn record(&mut self, code: i32, source: S, name: &str) -> Result<bool, String> {
+    /// Record section `code` starting at `source` (codes not read are ignored).
+    fn record(&mut self, code: i32, source: S, name: &str) -> Result<(), String> {
         let slot = match code {
             DIMENSION => &mut self.dimension,
             VERTICES => &mut self.vertices,
             TRIANGLES => &mut self.triangles,
             QUADRILATERALS => &mut self.quadrilaterals,
-            _ => return Ok(false),
+            _ => return Ok(()),
         };
-        if slot.replace(source).is_some() {
-            return Err(format!("a second {name} section"));
+        match slot.replace(source) {
+            Some(_) => Err(format!("a second {name} section")),
+            None => Ok(()),
         }
-        Ok(true)
     }
 }
 
@@ -156,8 +156,7 @@ fn parse_ascii(text: &str) -> Result<Surface, ParseError> {
     let mut tokens = Tokens::new(text, Some('#'));
     let mut sections = Sections::new();
     while let Some((line, token)) = tokens.next_token() {
-        let Some(&(code, name)) = SECTIONS.iter().find(|(_, name)| token.eq_ignore_ascii_case(name))
-        else {
+        let Some(&(code, name)) = SECTIONS.iter().find(|(_, name)| token.eq_ignore_ascii_case(name)) else {
             continue;
         };
         if code == END {
@@ -196,7 +195,10 @@ fn parse_binary(bytes: &[u8], big_endian: bool) -> Result<Surface, ParseError> {
         }
         // Positions must move forward, or a corrupt file could loop forever.
         if next <= start as i64 {
-            return Err(ParseError::at_byte(start, format!("next keyword position {next} does not move forward")));
+            return Err(ParseError::at_byte(
+                start,
+                format!("next keyword position {next} does not move forward"),
+            ));
         }
         reader.seek(next as u64, "a next-keyword position")?;
     }
@@ -241,18 +243,23 @@ fn read_elements<const N: usize>(
     surface: &mut Surface,
     refs: &mut Vec<i64>,
 ) -> Result<(), ParseError> {
-    let what = if N == 3 { "triangle" } else { "quadrilateral" };
+    let (what, corner_what, reference_what) = if N == 3 {
+        ("triangle", "a triangle vertex", "a triangle reference")
+    } else {
+        ("quadrilateral", "a quadrilateral vertex", "a quadrilateral reference")
+    };
     let count = source.count(what)?;
     let vertex_count = surface.points.len();
     surface.triangles.reserve(scan::capacity(count, source.remaining(), 8));
     for _ in 0..count {
         let mut corners = [0u32; N];
         for corner in &mut corners {
-            let value = source.int(&format!("a {what} vertex"))?;
-            *corner = scan::vertex_index(value, 1, vertex_count)
-                .ok_or_else(|| source.error(format!("{what}: {}", scan::bad_vertex(value, vertex_count, "from 1"))))?;
+            let value = source.int(corner_what)?;
+            *corner = scan::vertex_index(value, 1, vertex_count).ok_or_else(|| {
+                source.error(format!("{what}: {}", scan::bad_vertex(value, vertex_count, "from 1")))
+            })?;
         }
-        let reference = source.int(&format!("a {what} reference"))?;
+        let reference = source.int(reference_what)?;
         surface.triangles.push([corners[0], corners[1], corners[2]]);
         refs.push(reference);
         if let [a, _, c, d] = corners[..] {
@@ -291,7 +298,12 @@ fn write_binary(w: &mut dyn Write, s: &Surface) -> std::io::Result<()> {
 }
 
 /// Write `s` in binary libMeshb `version`, in either byte order (readers must take both).
-fn write_binary_version(w: &mut dyn Write, s: &Surface, version: i32, big_endian: bool) -> std::io::Result<()> {
+fn write_binary_version(
+    w: &mut dyn Write,
+    s: &Surface,
+    version: i32,
+    big_endian: bool,
+) -> std::io::Result<()> {
     let layout = Layout::of_version(version);
     let int = if layout.int8 { 8 } else { 4 };
     let real = if layout.real8 { 8 } else { 4 };
@@ -535,7 +547,11 @@ End
 
         let good = meshb(&unit_triangle());
         let e = parse_surface(&good[..good.len() - 14]).unwrap_err();
-        let expected = format!("points to byte {}, beyond the end of the file ({} bytes)", good.len() - 8, good.len() - 14);
+        let expected = format!(
+            "points to byte {}, beyond the end of the file ({} bytes)",
+            good.len() - 8,
+            good.len() - 14
+        );
         assert!(e.message.contains(&expected), "{e}");
         let no_end = meshb(&unit_triangle()[..4]);
         let e = parse_surface(&no_end[..no_end.len() - 2]).unwrap_err();

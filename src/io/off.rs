@@ -14,7 +14,8 @@ pub fn parse(bytes: &[u8]) -> Result<Surface, ParseError> {
     let mut surface = Surface::default();
     surface.points.reserve(scan::capacity(vertex_count, text.len(), 6));
     for k in 0..vertex_count {
-        let (line, content) = lines.next().ok_or_else(|| truncated(last_line, "vertices", k, vertex_count))?;
+        let (line, content) =
+            lines.next().ok_or_else(|| truncated(last_line, "vertices", k, vertex_count))?;
         surface.points.push(DVec3::from_array(scan::line_point(content, line, "a vertex")?));
         last_line = line;
     }
@@ -106,9 +107,8 @@ fn read_face(content: &str, line: usize, vertex_count: usize) -> Result<Vec<u32>
         .take(size)
         .map(|field| {
             let value: i64 = scan::parse_int(field, line, "a face vertex index")?;
-            scan::vertex_index(value, 0, vertex_count).ok_or_else(|| {
-                ParseError::at_line(line, scan::bad_vertex(value, vertex_count, "from 0"))
-            })
+            scan::vertex_index(value, 0, vertex_count)
+                .ok_or_else(|| ParseError::at_line(line, scan::bad_vertex(value, vertex_count, "from 0")))
         })
         .collect::<Result<Vec<u32>, ParseError>>()?;
     if corners.len() < size {

@@ -14,10 +14,7 @@ pub(crate) fn text(bytes: &[u8]) -> Cow<'_, str> {
 }
 
 /// The non-empty lines of `text` with their 1-based numbers, trimmed, each cut at `comment`.
-pub(crate) fn content_lines(
-    text: &str,
-    comment: Option<char>,
-) -> impl Iterator<Item = (usize, &str)> + '_ {
+pub(crate) fn content_lines(text: &str, comment: Option<char>) -> impl Iterator<Item = (usize, &str)> + '_ {
     text.lines().enumerate().filter_map(move |(i, line)| {
         let line = match comment.and_then(|c| line.find(c)) {
             Some(end) => &line[..end],
@@ -38,9 +35,7 @@ pub(crate) fn parse_f64(token: &str, line: usize, what: &str) -> Result<f64, Par
 
 /// Parse an integer of type `T` (out of `T`'s range is a bad number too).
 pub(crate) fn parse_int<T: FromStr>(token: &str, line: usize, what: &str) -> Result<T, ParseError> {
-    token
-        .parse()
-        .map_err(|_| ParseError::at_line(line, format!("bad integer '{token}' for {what}")))
+    token.parse().map_err(|_| ParseError::at_line(line, format!("bad integer '{token}' for {what}")))
 }
 
 /// The first three reals of a line (`what` = e.g. "a vertex"); what follows them is ignored.
@@ -48,9 +43,9 @@ pub(crate) fn line_point(text: &str, line: usize, what: &str) -> Result<[f64; 3]
     let mut p = [0.0; 3];
     let mut tokens = text.split_whitespace();
     for (i, coordinate) in p.iter_mut().enumerate() {
-        let token = tokens.next().ok_or_else(|| {
-            ParseError::at_line(line, format!("{what} needs 3 coordinates, found {i}"))
-        })?;
+        let token = tokens
+            .next()
+            .ok_or_else(|| ParseError::at_line(line, format!("{what} needs 3 coordinates, found {i}")))?;
         *coordinate = parse_f64(token, line, &format!("a coordinate of {what}"))?;
     }
     Ok(p)
@@ -148,35 +143,38 @@ impl<'a> Tokens<'a> {
     }
 
     /// The next token, or an error naming `what` was expected at the end of the file.
-    pub fn expect(&mut self, what: &str) -> Result<(usize, &'a str), ParseError> {
-        self.next_token().ok_or_else(|| {
-            ParseError::at_line(self.line(), format!("unexpected end of file: expected {what}"))
-        })
+    pub fn require(&mut self, what: &str) -> Result<(usize, &'a str), ParseError> {
+        self.next_token().ok_or_else(|| self.end_of_file(what))
+    }
+
+    fn end_of_file(&self, what: &str) -> ParseError {
+        ParseError::at_line(self.line(), format!("unexpected end of file: expected {what}"))
     }
 
     /// The next token, which must be `keyword` (ASCII case-insensitive).
     pub fn keyword(&mut self, keyword: &str) -> Result<usize, ParseError> {
-        let (line, token) = self.expect(&format!("'{keyword}'"))?;
-        if token.eq_ignore_ascii_case(keyword) {
-            Ok(line)
-        } else {
-            Err(ParseError::at_line(line, format!("expected '{keyword}', found '{token}'")))
+        match self.next_token() {
+            Some((line, token)) if token.eq_ignore_ascii_case(keyword) => Ok(line),
+            Some((line, token)) => {
+                Err(ParseError::at_line(line, format!("expected '{keyword}', found '{token}'")))
+            }
+            None => Err(self.end_of_file(&format!("'{keyword}'"))),
         }
     }
 
     pub fn real(&mut self, what: &str) -> Result<f64, ParseError> {
-        let (line, token) = self.expect(what)?;
+        let (line, token) = self.require(what)?;
         parse_f64(token, line, what)
     }
 
     pub fn int<T: FromStr>(&mut self, what: &str) -> Result<T, ParseError> {
-        let (line, token) = self.expect(what)?;
+        let (line, token) = self.require(what)?;
         parse_int(token, line, what)
     }
 
     /// A count of points or triangles: a non-negative integer `u32` indices can address.
     pub fn count(&mut self, what: &str) -> Result<usize, ParseError> {
-        let (line, token) = self.expect(&format!("{what} count"))?;
+        let (line, token) = self.require(&format!("{what} count"))?;
         let count: u64 = parse_int(token, line, &format!("{what} count"))?;
         check_count(count, what).map_err(|message| ParseError::at_line(line, message))
     }
@@ -248,10 +246,9 @@ impl<'a> ByteReader<'a> {
     /// The next `n` bytes.
     pub fn take(&mut self, n: usize, what: &str) -> Result<&'a [u8], ParseError> {
         if n > self.remaining() {
-            return Err(self.error(format!(
-                "file ends inside {what}: {n} bytes needed, {} left",
-                self.remaining()
-            )));
+            return Err(
+                self.error(format!("file ends inside {what}: {n} bytes needed, {} left", self.remaining()))
+            );
         }
         let bytes = &self.data[self.pos..self.pos + n];
         self.pos += n;
@@ -297,7 +294,7 @@ mod tests {
         let mut t = Tokens::new("a b # c d\n\n  e#f\r\ng", Some('#'));
         let all: Vec<_> = std::iter::from_fn(|| t.next_token()).collect();
         assert_eq!(all, vec![(1, "a"), (1, "b"), (3, "e"), (4, "g")]);
-        let e = t.expect("a vertex").unwrap_err();
+        let e = t.require("a vertex").unwrap_err();
         assert_eq!(e.at, super::super::Location::Line(4));
         assert!(e.message.contains("expected a vertex"), "{e}");
     }

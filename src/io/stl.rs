@@ -22,9 +22,7 @@ pub fn parse(bytes: &[u8]) -> Result<Surface, ParseError> {
     }
     match parse_ascii(&scan::text(bytes)) {
         Ok(surface) => Ok(surface),
-        Err(ascii_error) if binary_size_matches(bytes) => {
-            parse_binary(bytes).map_err(|_| ascii_error)
-        }
+        Err(ascii_error) if binary_size_matches(bytes) => parse_binary(bytes).map_err(|_| ascii_error),
         Err(ascii_error) => Err(ascii_error),
     }
 }
@@ -51,15 +49,13 @@ struct Soup {
 
 impl Soup {
     fn into_surface(self, patch_names: Vec<String>) -> Result<Surface, ParseError> {
-        let triangles = (0..self.triangle_patch.len() as u32)
-            .map(|t| [3 * t, 3 * t + 1, 3 * t + 2])
-            .collect();
-        let mut surface = Surface {
-            points: self.corners,
-            triangles,
-            triangle_patch: self.triangle_patch,
-            patch_names,
-        };
+        if self.corners.len() > scan::MAX_COUNT {
+            return Err(ParseError::file("too many vertices for 32-bit indices"));
+        }
+        let triangles =
+            (0..self.triangle_patch.len() as u32).map(|t| [3 * t, 3 * t + 1, 3 * t + 2]).collect();
+        let mut surface =
+            Surface { points: self.corners, triangles, triangle_patch: self.triangle_patch, patch_names };
         surface.weld_exact();
         scan::finish(surface)
     }
@@ -82,16 +78,13 @@ fn parse_ascii(text: &str) -> Result<Surface, ParseError> {
         let patch = patches.index(&name);
         read_facets(&mut tokens, &mut soup, patch)?;
     }
-    if soup.corners.len() > scan::MAX_COUNT {
-        return Err(ParseError::file("too many vertices for 32-bit indices"));
-    }
     soup.into_surface(patches.into_names())
 }
 
 /// Read the facets of one solid, through its `endsolid` line.
 fn read_facets(tokens: &mut Tokens, soup: &mut Soup, patch: u32) -> Result<(), ParseError> {
     loop {
-        let (line, word) = tokens.expect("'facet' or 'endsolid'")?;
+        let (line, word) = tokens.require("'facet' or 'endsolid'")?;
         if word.eq_ignore_ascii_case("endsolid") {
             tokens.rest_of_line();
             return Ok(());
@@ -99,10 +92,7 @@ fn read_facets(tokens: &mut Tokens, soup: &mut Soup, patch: u32) -> Result<(), P
             read_facet(tokens, soup)?;
             soup.triangle_patch.push(patch);
         } else {
-            return Err(ParseError::at_line(
-                line,
-                format!("expected 'facet' or 'endsolid', found '{word}'"),
-            ));
+            return Err(ParseError::at_line(line, format!("expected 'facet' or 'endsolid', found '{word}'")));
         }
     }
 }

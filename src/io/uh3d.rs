@@ -97,7 +97,10 @@ fn read_node(content: &str, line: usize, k: usize) -> Result<DVec3, ParseError> 
     let f = fields_of(content, line, 4, "id, x, y, z")?;
     let id: u64 = scan::parse_int(f[0], line, "a node id")?;
     if id != k as u64 + 1 {
-        return Err(ParseError::at_line(line, format!("node id {id} where {} was expected (ids must be 1, 2, ... in order)", k + 1)));
+        return Err(ParseError::at_line(
+            line,
+            format!("node id {id} where {} was expected (ids must be 1, 2, ... in order)", k + 1),
+        ));
     }
     let mut p = [0.0; 3];
     for (c, token) in p.iter_mut().zip(&f[1..]) {

@@ -159,7 +159,13 @@ mod tests {
 
     fn soup() -> Surface {
         Surface {
-            points: vec![DVec3::X, DVec3::new(9.0, 9.0, 9.0), DVec3::ZERO, DVec3::X, DVec3::new(-0.0, 0.0, 0.0)],
+            points: vec![
+                DVec3::X,
+                DVec3::new(9.0, 9.0, 9.0),
+                DVec3::ZERO,
+                DVec3::X,
+                DVec3::new(-0.0, 0.0, 0.0),
+            ],
             triangles: vec![[0, 2, 3], [3, 4, 0]],
             triangle_patch: vec![0, 0],
             patch_names: vec!["wall".into()],
