@@ -11,6 +11,7 @@
 //! triangle surface with named patches) and [`mesh`] (the hybrid volume mesh and its node orders).
 
 pub mod cli;
+pub mod config;
 pub mod geometry;
 pub mod io;
 pub mod mesh;
