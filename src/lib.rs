@@ -15,5 +15,6 @@ pub mod config;
 pub mod geometry;
 pub mod io;
 pub mod mesh;
+pub mod normals;
 pub mod quality;
 pub mod surface;
