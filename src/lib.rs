@@ -14,6 +14,7 @@ pub mod cli;
 pub mod config;
 pub mod geometry;
 pub mod io;
+pub mod layers;
 pub mod mesh;
 pub mod normals;
 pub mod quality;
