@@ -65,3 +65,5 @@ impl Surface {
         }
     }
 }
+
+pub mod shapes;
