@@ -207,3 +207,5 @@ mod tests {
         assert_eq!(table.into_names(), vec!["b", "a"]);
     }
 }
+
+pub mod shapes;
