@@ -212,6 +212,7 @@ fn read_binary_integers(r: &mut ByteReader, count: usize, what: &str) -> Result<
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::scan::testing::assert_error;
     use crate::io::Location;
     use proptest::prelude::*;
 
@@ -242,19 +243,31 @@ mod tests {
 
     #[test]
     fn malformed_ascii_names_the_line() {
-        let e = parse(TETRA.replace("2 3 4\n", "2 3 5\n").as_bytes()).unwrap_err();
-        assert_eq!(e.at, Location::Line(8));
-        assert!(e.message.contains("vertex index 5 out of range"), "{e}");
-        let e = parse(TETRA.replace("1 1 7 7\n", "1 1 7\n").as_bytes()).unwrap_err();
-        assert_eq!(e.at, Location::Line(9));
-        assert!(e.message.contains("end of file: expected a component id"), "{e}");
-        let e = parse(&TETRA.as_bytes()[..TETRA.find("1 2 4").unwrap()]).unwrap_err();
-        assert_eq!(e.at, Location::Line(5));
-        assert!(e.message.contains("expected a triangle vertex index"), "{e}");
-        let e = parse(TETRA.replace("0 0 1\n", "0 0 one\n").as_bytes()).unwrap_err();
-        assert!(e.message.contains("bad number 'one'") && e.at == Location::Line(4), "{e}");
-        let e = parse(b"4\n0 0 0\n").unwrap_err();
-        assert!(e.message.contains("nVerts nTris") && e.at == Location::Line(1), "{e}");
+        assert_error(
+            parse,
+            TETRA.replace("2 3 4\n", "2 3 5\n").as_bytes(),
+            Location::Line(8),
+            "vertex index 5 out of range",
+        );
+        assert_error(
+            parse,
+            TETRA.replace("1 1 7 7\n", "1 1 7\n").as_bytes(),
+            Location::Line(9),
+            "end of file: expected a component id",
+        );
+        assert_error(
+            parse,
+            &TETRA.as_bytes()[..TETRA.find("1 2 4").unwrap()],
+            Location::Line(5),
+            "expected a triangle vertex index",
+        );
+        assert_error(
+            parse,
+            TETRA.replace("0 0 1\n", "0 0 one\n").as_bytes(),
+            Location::Line(4),
+            "bad number 'one'",
+        );
+        assert_error(parse, b"4\n0 0 0\n", Location::Line(1), "nVerts nTris");
     }
 
     /// Write `s` as a Fortran-unformatted binary .tri (4- or 8-byte reals, 4-byte integers).
@@ -309,18 +322,18 @@ mod tests {
         let ascii = parse(TETRA.as_bytes()).unwrap();
         let good = binary_tri(&ascii, false, false, true);
         // header 16 bytes, then the vertex record (4 + 48 + 4).
-        let e = parse(&good[..40]).unwrap_err();
-        assert_eq!(e.at, Location::Byte(16));
-        assert!(e.message.contains("vertex record says 48 bytes but only 20 are left"), "{e}");
+        assert_error(
+            parse,
+            &good[..40],
+            Location::Byte(16),
+            "vertex record says 48 bytes but only 20 are left",
+        );
         let mut bad_marker = good.clone();
         bad_marker[68] = 47;
-        let e = parse(&bad_marker).unwrap_err();
-        assert_eq!(e.at, Location::Byte(68));
-        assert!(e.message.contains("ends with length marker 47, its start said 48"), "{e}");
+        assert_error(parse, &bad_marker, Location::Byte(68), "ends with length marker 47, its start said 48");
         let mut bad_index = good.clone();
         bad_index[76..80].copy_from_slice(&9i32.to_le_bytes());
-        let e = parse(&bad_index).unwrap_err();
-        assert!(e.message.contains("triangle 1: vertex index 9 out of range"), "{e}");
+        assert_error(parse, &bad_index, Location::Byte(72), "triangle 1: vertex index 9 out of range");
     }
 
     proptest! {

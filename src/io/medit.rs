@@ -1,7 +1,8 @@
 //! Medit / libMeshb surfaces: `.mesh` (ASCII) and `.meshb` (binary), read and written.
 //!
-//! Only `Dimension` (3, assumed when absent), `Vertices`, `Triangles` and `Quadrilaterals` (split in two triangles)
-//! are read; every other section is skipped. Each element reference becomes patch `ref_<n>`.
+//! Only `Dimension` (3, assumed when absent), `Vertices`, `Triangles` and `Quadrilaterals`
+//! (split in two triangles) are read; every other section is skipped. Each element reference
+//! becomes patch `ref_<n>`.
 //! ASCII keywords are case-insensitive and found wherever they are, as libMeshb does.
 //! Binary files start with the integer 1 (its byte order gives the file's), then the version:
 //! 1 = 4-byte reals, 2 = 8-byte reals, 3 = also 8-byte keyword positions, 4 = also 8-byte
@@ -182,6 +183,7 @@ fn parse_binary(bytes: &[u8], big_endian: bool) -> Result<Surface, ParseError> {
         if code == END {
             break;
         }
+        let position_at = reader.pos() as u64;
         let next = if layout.position8 {
             reader.i64("a next-keyword position")?
         } else {
@@ -195,12 +197,12 @@ fn parse_binary(bytes: &[u8], big_endian: bool) -> Result<Surface, ParseError> {
         }
         // Positions must move forward, or a corrupt file could loop forever.
         if next <= start as i64 {
-            return Err(ParseError::at_byte(
-                start,
-                format!("next keyword position {next} does not move forward"),
-            ));
+            let message = format!("next keyword position {next} does not move forward");
+            return Err(ParseError::at_byte(position_at, message));
         }
-        reader.seek(next as u64, "a next-keyword position")?;
+        reader
+            .seek(next as u64, "the next-keyword position")
+            .map_err(|e| ParseError::at_byte(position_at, e.message))?;
     }
     read_sections(sections)
 }
@@ -389,6 +391,7 @@ impl BinaryWriter<'_> {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::scan::testing::assert_error;
     use crate::io::Location;
     use proptest::prelude::*;
 
@@ -430,27 +433,45 @@ End
         assert!((s.enclosed_volume() - 1.0 / 3.0).abs() < 1e-15);
     }
 
-    fn error(text: &str) -> (Location, String) {
-        let e = parse_surface(text.as_bytes()).unwrap_err();
-        (e.at, e.message)
-    }
-
     #[test]
     fn malformed_ascii_names_the_line() {
-        let (at, msg) = error(&PYRAMID.replace("3 4 5 1", "3 4 6 1"));
-        assert!(msg.contains("triangle: vertex index 6 out of range") && at == Location::Line(18), "{msg}");
-        let (at, msg) = error(&PYRAMID.replace("0.5 0.5 1 7", "0.5 0.5 x 7"));
-        assert!(msg.contains("bad number 'x'") && at == Location::Line(10), "{msg}");
-        let (at, msg) = error(&PYRAMID[..PYRAMID.find("0 1 0 0").unwrap()]);
-        assert!(msg.contains("end of file: expected a vertex") && at == Location::Line(8), "{msg}");
-        let (at, msg) = error(&PYRAMID.replace("dimension\n3", "Dimension 2"));
-        assert!(msg.contains("dimension 2") && at == Location::Line(3), "{msg}");
-        let (at, msg) = error(&PYRAMID.replace("Vertices", "Vertexes"));
-        assert!(msg.contains("no Vertices") && at == Location::File, "{msg}");
-        let (at, msg) = error(&PYRAMID.replace("Corners 1 5", "Triangles 0"));
-        assert!(msg.contains("a second Triangles section") && at == Location::Line(14), "{msg}");
-        let (at, msg) = error(&PYRAMID.replace("Vertices 5", "Vertices -5"));
-        assert!(msg.contains("negative vertex count") && at == Location::Line(5), "{msg}");
+        assert_error(
+            parse_surface,
+            &PYRAMID.replace("3 4 5 1", "3 4 6 1"),
+            Location::Line(18),
+            "triangle: vertex index 6 out of range",
+        );
+        assert_error(
+            parse_surface,
+            &PYRAMID.replace("0.5 0.5 1 7", "0.5 0.5 x 7"),
+            Location::Line(10),
+            "bad number 'x'",
+        );
+        assert_error(
+            parse_surface,
+            &PYRAMID[..PYRAMID.find("0 1 0 0").unwrap()],
+            Location::Line(8),
+            "end of file: expected a vertex",
+        );
+        assert_error(
+            parse_surface,
+            &PYRAMID.replace("dimension\n3", "Dimension 2"),
+            Location::Line(3),
+            "dimension 2",
+        );
+        assert_error(parse_surface, &PYRAMID.replace("Vertices", "Vertexes"), Location::File, "no Vertices");
+        assert_error(
+            parse_surface,
+            &PYRAMID.replace("Corners 1 5", "Triangles 0"),
+            Location::Line(14),
+            "a second Triangles section",
+        );
+        assert_error(
+            parse_surface,
+            &PYRAMID.replace("Vertices 5", "Vertices -5"),
+            Location::Line(5),
+            "negative vertex count",
+        );
     }
 
     fn written(s: &Surface, version: i32, big_endian: bool) -> Vec<u8> {
@@ -531,35 +552,35 @@ End
         let mut bad_index = unit_triangle();
         bad_index[3].1 = ints(&[1, 1, 2, 9, 4]);
         let bytes = meshb(&bad_index);
-        let e = parse_surface(&bytes).unwrap_err();
-        assert_eq!(e.at, Location::Byte(bytes.len() as u64 - 12 - 4));
-        assert!(e.message.contains("vertex index 9 out of range"), "{e}");
+        assert_error(
+            parse_surface,
+            &bytes,
+            Location::Byte(bytes.len() as u64 - 12 - 4),
+            "vertex index 9 out of range",
+        );
 
         let mut backwards = meshb(&unit_triangle());
         backwards[12..16].copy_from_slice(&4i32.to_le_bytes());
-        let e = parse_surface(&backwards).unwrap_err();
-        assert_eq!(e.at, Location::Byte(8));
-        assert!(e.message.contains("does not move forward"), "{e}");
+        assert_error(parse_surface, &backwards, Location::Byte(12), "does not move forward");
 
         let mut beyond = meshb(&unit_triangle());
         beyond[12..16].copy_from_slice(&1000i32.to_le_bytes());
-        assert!(parse_surface(&beyond).unwrap_err().message.contains("beyond the end of the file"));
+        assert_error(parse_surface, &beyond, Location::Byte(12), "points to byte 1000, beyond the end");
 
         let good = meshb(&unit_triangle());
-        let e = parse_surface(&good[..good.len() - 14]).unwrap_err();
-        let expected = format!(
-            "points to byte {}, beyond the end of the file ({} bytes)",
-            good.len() - 8,
-            good.len() - 14
-        );
-        assert!(e.message.contains(&expected), "{e}");
+        let (end_at, cut) = (good.len() - 8, good.len() - 14);
+        let message = format!("points to byte {end_at}, beyond the end of the file ({cut} bytes)");
+        assert_error(parse_surface, &good[..cut], Location::Byte(end_at as u64 - 28 + 4), &message);
         let no_end = meshb(&unit_triangle()[..4]);
-        let e = parse_surface(&no_end[..no_end.len() - 2]).unwrap_err();
-        assert_eq!(e.at, Location::Byte(no_end.len() as u64 - 4));
-        assert!(e.message.contains("file ends inside a triangle reference"), "{e}");
+        assert_error(
+            parse_surface,
+            &no_end[..no_end.len() - 2],
+            Location::Byte(no_end.len() as u64 - 4),
+            "file ends inside a triangle reference",
+        );
         let mut version = good.clone();
         version[4] = 9;
-        assert!(parse_surface(&version).unwrap_err().message.contains("unknown libMeshb version 9"));
+        assert_error(parse_surface, &version, Location::Byte(4), "unknown libMeshb version 9");
     }
 
     proptest! {

@@ -103,6 +103,7 @@ fn group_name(rest: &str) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::scan::testing::assert_error;
     use crate::io::Location;
     use proptest::prelude::*;
 
@@ -146,37 +147,28 @@ l 1 2
         assert_eq!(s.triangles, vec![[0, 1, 2]]);
     }
 
-    fn error(text: &str) -> (Location, String) {
-        let e = parse(text.as_bytes()).unwrap_err();
-        (e.at, e.message)
-    }
-
     #[test]
     fn bad_lines_are_named() {
-        let (at, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n");
-        assert_eq!(at, Location::Line(4));
-        assert!(msg.contains("vertex index 4 out of range") && msg.contains("3 vertices"), "{msg}");
-        let (at, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n");
-        assert_eq!(at, Location::Line(4));
-        assert!(msg.contains("vertex index -4 out of range"), "{msg}");
-        let (at, msg) = error("v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n");
-        assert_eq!(at, Location::Line(4));
-        assert!(msg.contains("vertex index 0"), "{msg}");
-        let (at, msg) = error("v 0 0\n");
-        assert_eq!(at, Location::Line(1));
-        assert!(msg.contains("a vertex needs 3 coordinates, found 2"), "{msg}");
-        let (at, msg) = error("v 0 0 zero\n");
-        assert!(msg.contains("bad number 'zero'") && at == Location::Line(1), "{msg}");
-        let (at, msg) = error("v 0 0 0\nv 1 0 0\n\nf 1 2\n");
-        assert!(msg.contains("at least 3 vertices") && at == Location::Line(4), "{msg}");
-        let (at, msg) = error("v 0 0 0\nf 1 x 1\n");
-        assert!(msg.contains("bad integer 'x'") && at == Location::Line(2), "{msg}");
-        let (at, msg) = error("v 0 0 0\ncurv 0 1 1 2\n");
-        assert!(msg.contains("free-form") && at == Location::Line(2), "{msg}");
-        let (at, msg) = error("v 0 0 0\nbogus 1\n");
-        assert!(msg.contains("unknown OBJ statement 'bogus'") && at == Location::Line(2), "{msg}");
-        let (at, msg) = error("v 0 0 0\n");
-        assert!(msg.contains("no triangles") && at == Location::File, "{msg}");
+        assert_error(
+            parse,
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 4\n",
+            Location::Line(4),
+            "vertex index 4 out of range: the file has 3 vertices",
+        );
+        assert_error(
+            parse,
+            "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -1 -2 -4\n",
+            Location::Line(4),
+            "vertex index -4 out of range",
+        );
+        assert_error(parse, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 0 1 2\n", Location::Line(4), "vertex index 0");
+        assert_error(parse, "v 0 0\n", Location::Line(1), "a vertex needs 3 coordinates, found 2");
+        assert_error(parse, "v 0 0 zero\n", Location::Line(1), "bad number 'zero'");
+        assert_error(parse, "v 0 0 0\nv 1 0 0\n\nf 1 2\n", Location::Line(4), "at least 3 vertices");
+        assert_error(parse, "v 0 0 0\nf 1 x 1\n", Location::Line(2), "bad integer 'x'");
+        assert_error(parse, "v 0 0 0\ncurv 0 1 1 2\n", Location::Line(2), "free-form");
+        assert_error(parse, "v 0 0 0\nbogus 1\n", Location::Line(2), "unknown OBJ statement 'bogus'");
+        assert_error(parse, "v 0 0 0\n", Location::File, "no triangles");
     }
 
     proptest! {

@@ -123,6 +123,7 @@ fn read_face(content: &str, line: usize, vertex_count: usize) -> Result<Vec<u32>
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::scan::testing::assert_error;
     use crate::io::Location;
     use proptest::prelude::*;
 
@@ -160,39 +161,35 @@ mod tests {
         assert!(parse(SQUARE_PYRAMID.replacen("OFF", "NOFF", 1).as_bytes()).is_ok());
     }
 
-    fn error(text: &str) -> (Location, String) {
-        let e = parse(text.as_bytes()).unwrap_err();
-        (e.at, e.message)
-    }
-
     #[test]
     fn malformed_files_name_the_line() {
         let cut = &SQUARE_PYRAMID[..SQUARE_PYRAMID.find("3 1 2 4").unwrap()];
-        let (at, msg) = error(cut);
-        assert_eq!(at, Location::Line(10));
-        assert!(msg.contains("file ends after 2 of the 5 faces"), "{msg}");
-        let (at, msg) = error(&SQUARE_PYRAMID[..SQUARE_PYRAMID.find("0 1 0").unwrap()]);
-        assert_eq!(at, Location::Line(6));
-        assert!(msg.contains("after 3 of the 5 vertices"), "{msg}");
-        let (at, msg) = error(&SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3 5"));
-        assert_eq!(at, Location::Line(12));
-        assert!(msg.contains("vertex index 5 out of range") && msg.contains("5 vertices"), "{msg}");
-        let (at, msg) = error(&SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3"));
-        assert!(msg.contains("lists only 2") && at == Location::Line(12), "{msg}");
-        let (at, msg) = error(&SQUARE_PYRAMID.replace("3 2 3 4", "2 2 3"));
-        assert!(msg.contains("at least 3") && at == Location::Line(12), "{msg}");
-        let (at, msg) = error(&SQUARE_PYRAMID.replace("1 1 0", "1 1"));
-        assert!(msg.contains("needs 3 coordinates, found 2") && at == Location::Line(6), "{msg}");
-        let (at, msg) = error(&format!("{SQUARE_PYRAMID}3 0 1 2\n"));
-        assert!(msg.contains("after the 5 faces") && at == Location::Line(14), "{msg}");
-        let (at, msg) = error("4OFF\n1 1 0\n");
-        assert!(msg.contains("not supported") && at == Location::Line(1), "{msg}");
-        let (at, msg) = error("PLY\n");
-        assert!(msg.contains("not an OFF file") && at == Location::Line(1), "{msg}");
-        let (at, msg) = error("OFF\n3 x 0\n");
-        assert!(msg.contains("bad integer 'x'") && at == Location::Line(2), "{msg}");
-        let (at, msg) = error("OFF 99999999999 1 0\n");
-        assert!(msg.contains("exceeds") && at == Location::Line(1), "{msg}");
+        assert_error(parse, cut, Location::Line(10), "file ends after 2 of the 5 faces");
+        assert_error(
+            parse,
+            &SQUARE_PYRAMID[..SQUARE_PYRAMID.find("0 1 0").unwrap()],
+            Location::Line(6),
+            "after 3 of the 5 vertices",
+        );
+        assert_error(
+            parse,
+            &SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3 5"),
+            Location::Line(12),
+            "vertex index 5 out of range: the file has 5 vertices",
+        );
+        assert_error(parse, &SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3"), Location::Line(12), "lists only 2");
+        assert_error(parse, &SQUARE_PYRAMID.replace("3 2 3 4", "2 2 3"), Location::Line(12), "at least 3");
+        assert_error(
+            parse,
+            &SQUARE_PYRAMID.replace("1 1 0", "1 1"),
+            Location::Line(6),
+            "needs 3 coordinates, found 2",
+        );
+        assert_error(parse, &format!("{SQUARE_PYRAMID}3 0 1 2\n"), Location::Line(14), "after the 5 faces");
+        assert_error(parse, "4OFF\n1 1 0\n", Location::Line(1), "not supported");
+        assert_error(parse, "PLY\n", Location::Line(1), "not an OFF file");
+        assert_error(parse, "OFF\n3 x 0\n", Location::Line(2), "bad integer 'x'");
+        assert_error(parse, "OFF 99999999999 1 0\n", Location::Line(1), "exceeds");
     }
 
     proptest! {

@@ -285,6 +285,30 @@ impl<'a> ByteReader<'a> {
     }
 }
 
+/// Test helpers shared by the readers' tests.
+#[cfg(test)]
+pub(crate) mod testing {
+    use super::super::{Location, ParseError};
+    use crate::surface::Surface;
+
+    /// Assert that `parse` rejects `bytes` at `at` with a message that contains `needle`.
+    #[track_caller]
+    pub fn assert_error(
+        parse: fn(&[u8]) -> Result<Surface, ParseError>,
+        bytes: impl AsRef<[u8]>,
+        at: Location,
+        needle: &str,
+    ) {
+        match parse(bytes.as_ref()) {
+            Ok(s) => panic!("accepted ({} triangles), expected an error with '{needle}'", s.triangles.len()),
+            Err(e) => {
+                assert!(e.message.contains(needle), "'{e}' does not say '{needle}'");
+                assert_eq!(e.at, at, "{e}");
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

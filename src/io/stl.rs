@@ -187,6 +187,7 @@ fn binary_patch_name(header: &[u8]) -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::scan::testing::assert_error;
     use crate::io::Location;
     use proptest::prelude::*;
 
@@ -254,41 +255,46 @@ endsolid
         assert_eq!(s.triangle_patch, vec![0, 0]);
     }
 
-    fn ascii_error(text: &str) -> (Location, String) {
-        let e = parse(text.as_bytes()).unwrap_err();
-        (e.at, e.message)
-    }
-
     #[test]
     fn malformed_ascii_names_the_line_and_the_problem() {
         let missing_vertex = TWO_SOLIDS.replacen("      vertex 0 1 0\n", "", 1);
-        let (at, msg) = ascii_error(&missing_vertex);
-        assert_eq!(at, Location::Line(6));
-        assert!(msg.contains("expected 'vertex', found 'endloop'"), "{msg}");
-
-        let (at, msg) = ascii_error(&TWO_SOLIDS.replacen("vertex 1 0 0", "vertex 1 0x 0", 1));
-        assert_eq!(at, Location::Line(5));
-        assert!(msg.contains("bad number '0x'"), "{msg}");
-
-        let (at, msg) = ascii_error(&TWO_SOLIDS.replacen("    endloop\n", "", 1));
-        assert_eq!(at, Location::Line(7));
-        assert!(msg.contains("expected 'endloop', found 'endfacet'"), "{msg}");
-
-        let (at, msg) = ascii_error(&TWO_SOLIDS.replacen("  endfacet\n", "", 1));
-        assert_eq!(at, Location::Line(8));
-        assert!(msg.contains("expected 'endfacet', found 'endsolid'"), "{msg}");
-
-        let (at, msg) = ascii_error(TWO_SOLIDS.trim_end().strip_suffix("endsolid").unwrap());
-        assert_eq!(at, Location::Line(17));
-        assert!(msg.contains("end of file: expected 'facet' or 'endsolid'"), "{msg}");
-
-        let (at, msg) = ascii_error(&TWO_SOLIDS[..TWO_SOLIDS.find("vertex 0 1 0").unwrap()]);
-        assert_eq!(at, Location::Line(5));
-        assert!(msg.contains("end of file: expected 'vertex'"), "{msg}");
-
-        let (at, msg) = ascii_error(&format!("{TWO_SOLIDS}junk"));
-        assert_eq!(at, Location::Line(19));
-        assert!(msg.contains("expected 'solid', found 'junk'"), "{msg}");
+        assert_error(parse, &missing_vertex, Location::Line(6), "expected 'vertex', found 'endloop'");
+        assert_error(
+            parse,
+            &TWO_SOLIDS.replacen("vertex 1 0 0", "vertex 1 0x 0", 1),
+            Location::Line(5),
+            "bad number '0x'",
+        );
+        assert_error(
+            parse,
+            &TWO_SOLIDS.replacen("    endloop\n", "", 1),
+            Location::Line(7),
+            "expected 'endloop', found 'endfacet'",
+        );
+        assert_error(
+            parse,
+            &TWO_SOLIDS.replacen("  endfacet\n", "", 1),
+            Location::Line(8),
+            "expected 'endfacet', found 'endsolid'",
+        );
+        assert_error(
+            parse,
+            TWO_SOLIDS.trim_end().strip_suffix("endsolid").unwrap(),
+            Location::Line(17),
+            "end of file: expected 'facet' or 'endsolid'",
+        );
+        assert_error(
+            parse,
+            &TWO_SOLIDS[..TWO_SOLIDS.find("vertex 0 1 0").unwrap()],
+            Location::Line(5),
+            "end of file: expected 'vertex'",
+        );
+        assert_error(
+            parse,
+            &format!("{TWO_SOLIDS}junk"),
+            Location::Line(19),
+            "expected 'solid', found 'junk'",
+        );
     }
 
     #[test]
@@ -317,17 +323,17 @@ endsolid
     #[test]
     fn binary_size_mismatch_says_where_and_how_much() {
         let full = binary(b"x", &TETRA);
-        let e = parse(&full[..full.len() - 7]).unwrap_err();
-        assert_eq!(e.at, Location::Byte(84 + 3 * 50));
-        assert!(e.message.contains("4 triangles (284 bytes) but the file has 277 bytes"), "{e}");
+        assert_error(
+            parse,
+            &full[..full.len() - 7],
+            Location::Byte(84 + 3 * 50),
+            "4 triangles (284 bytes) but the file has 277 bytes",
+        );
         let mut long = full.clone();
         long.push(0);
-        let e = parse(&long).unwrap_err();
-        assert_eq!(e.at, Location::Byte(284));
-        assert!(e.message.contains("1 bytes after its 4 triangles"), "{e}");
-        let e = parse(&full[..50]).unwrap_err();
-        assert!(e.message.contains("too short"), "{e}");
-        assert!(parse(&binary(b"x", &[])).unwrap_err().message.contains("no triangles"));
+        assert_error(parse, &long, Location::Byte(284), "1 bytes after its 4 triangles");
+        assert_error(parse, &full[..50], Location::Byte(50), "too short for a binary STL header");
+        assert_error(parse, binary(b"x", &[]), Location::File, "no triangles");
     }
 
     proptest! {

@@ -145,6 +145,7 @@ fn read_component_names<'a>(
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::io::scan::testing::assert_error;
     use crate::io::Location;
     use proptest::prelude::*;
 
@@ -173,29 +174,41 @@ mod tests {
         assert!((s.enclosed_volume() - 1.0 / 6.0).abs() < 1e-15);
     }
 
-    fn error(text: &str) -> (Location, String) {
-        let e = parse(text.as_bytes()).unwrap_err();
-        (e.at, e.message)
-    }
-
     #[test]
     fn malformed_lines_are_named() {
-        let (at, msg) = error(&TETRA.replace("4, 2, 3, 4, 2", "4, 2, 3, 9, 2"));
-        assert!(msg.contains("vertex index 9 out of range") && at == Location::Line(10), "{msg}");
-        let (at, msg) = error(&TETRA.replace("3, 0., 1., 0.", "7, 0., 1., 0."));
-        assert!(msg.contains("node id 7 where 3 was expected") && at == Location::Line(5), "{msg}");
-        let (at, msg) = error(&TETRA.replace("3, 0., 1., 0.", "3, 0., 1."));
-        assert!(msg.contains("expected 'id, x, y, z'") && at == Location::Line(5), "{msg}");
-        let (at, msg) = error(&TETRA.replace("1., 0.\n", "1., zero\n"));
-        assert!(msg.contains("bad number 'zero'") && at == Location::Line(5), "{msg}");
-        let (at, msg) = error(&TETRA[..TETRA.find("3, 1, 4").unwrap()]);
-        assert!(msg.contains("after 2 of the 4 triangles") && at == Location::Line(8), "{msg}");
-        let (at, msg) = error(&format!("{TETRA}more\n"));
-        assert!(msg.contains("unexpected line after the triangles") && at == Location::Line(14), "{msg}");
-        let (at, msg) = error("title\n4; 4\n");
-        assert!(msg.contains("expected 'nNodes") && at == Location::Line(2), "{msg}");
-        let (at, msg) = error("title only");
-        assert!(msg.contains("no counts line") && at == Location::File, "{msg}");
+        assert_error(
+            parse,
+            &TETRA.replace("4, 2, 3, 4, 2", "4, 2, 3, 9, 2"),
+            Location::Line(10),
+            "vertex index 9 out of range",
+        );
+        assert_error(
+            parse,
+            &TETRA.replace("3, 0., 1., 0.", "7, 0., 1., 0."),
+            Location::Line(5),
+            "node id 7 where 3 was expected",
+        );
+        assert_error(
+            parse,
+            &TETRA.replace("3, 0., 1., 0.", "3, 0., 1."),
+            Location::Line(5),
+            "expected 'id, x, y, z'",
+        );
+        assert_error(parse, &TETRA.replace("1., 0.\n", "1., zero\n"), Location::Line(5), "bad number 'zero'");
+        assert_error(
+            parse,
+            &TETRA[..TETRA.find("3, 1, 4").unwrap()],
+            Location::Line(8),
+            "after 2 of the 4 triangles",
+        );
+        assert_error(
+            parse,
+            &format!("{TETRA}more\n"),
+            Location::Line(14),
+            "unexpected line after the triangles",
+        );
+        assert_error(parse, "title\n4; 4\n", Location::Line(2), "expected 'nNodes");
+        assert_error(parse, "title only", Location::File, "no counts line");
     }
 
     proptest! {
