@@ -16,19 +16,20 @@ fn read(name: &str) -> Surface {
     read_surface(&geometry(name)).unwrap_or_else(|e| panic!("{e}"))
 }
 
-/// (file, triangles, patches where the README gives them)
-const TABLE: &[(&str, usize, Option<usize>)] = &[
-    ("cutcube_cfmesh.stl", 48, Some(2)),
-    ("mech_test_gapdetection.obj", 76, None),
-    ("building_wtc2.obj", 198, None),
-    ("fandisk.obj", 12946, None),
-    ("flange.stl", 6468, Some(4)),
-    ("spot.obj", 5856, None),
-    ("bunny_closed_herholz.off", 28576, None),
-    ("arrow_cape.uh3d", 9216, Some(7)),
-    ("arrow_cape.stl", 9216, Some(7)),
-    ("elbow_90degree_cfmesh.stl", 5150, Some(9)),
-    ("onera_m6_gmsh_coarse.stl", 28944, Some(11)),
+/// (file, triangles, patches where the README gives them, genus). The genus checks the
+/// vertex count (welding, unused points) through Euler's formula for a closed surface.
+const TABLE: &[(&str, usize, Option<usize>, i64)] = &[
+    ("cutcube_cfmesh.stl", 48, Some(2), 0),
+    ("mech_test_gapdetection.obj", 76, None, 0),
+    ("building_wtc2.obj", 198, None, 0),
+    ("fandisk.obj", 12946, None, 0),
+    ("flange.stl", 6468, Some(4), 4),
+    ("spot.obj", 5856, None, 0),
+    ("bunny_closed_herholz.off", 28576, None, 0),
+    ("arrow_cape.uh3d", 9216, Some(7), 0),
+    ("arrow_cape.stl", 9216, Some(7), 0),
+    ("elbow_90degree_cfmesh.stl", 5150, Some(9), 0),
+    ("onera_m6_gmsh_coarse.stl", 28944, Some(11), 0),
 ];
 
 /// Every index in range, every point used, one patch per triangle and every patch used.
@@ -55,9 +56,12 @@ fn every_geometry_reads_with_the_readme_counts() {
         .collect();
     let listed: BTreeSet<String> = TABLE.iter().map(|(f, ..)| f.to_string()).collect();
     assert_eq!(files, listed, "every file of the geometries folder is in the table");
-    for &(name, triangles, patches) in TABLE {
+    for &(name, triangles, patches, genus) in TABLE {
         let s = read(name);
         assert_eq!(s.triangles.len(), triangles, "{name}: triangles");
+        // V - E + T = 2 - 2 genus with E = 3T/2.
+        let euler = 2 * s.points.len() as i64 - triangles as i64;
+        assert_eq!(euler, 4 - 4 * genus, "{name}: {} points", s.points.len());
         if let Some(p) = patches {
             assert_eq!(s.patch_names.len(), p, "{name}: patches {:?}", s.patch_names);
         }

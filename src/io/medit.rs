@@ -262,10 +262,8 @@ fn read_elements<const N: usize>(
             })?;
         }
         let reference = source.int(reference_what)?;
-        surface.triangles.push([corners[0], corners[1], corners[2]]);
-        refs.push(reference);
-        if let [a, _, c, d] = corners[..] {
-            surface.triangles.push([a, c, d]);
+        for triangle in scan::fan(&corners) {
+            surface.triangles.push(triangle);
             refs.push(reference);
         }
     }
@@ -592,6 +590,20 @@ End
                 binary.extend(&bytes);
                 let _ = parse_surface(&binary);
             }
+        }
+
+        #[test]
+        fn corrupted_binary_never_panics(
+            edits in proptest::collection::vec((0usize..400, any::<u8>()), 1..4),
+            version in 1i32..=4,
+        ) {
+            let s = parse_surface(PYRAMID.as_bytes()).unwrap();
+            let mut binary = written(&s, version, false);
+            for (at, byte) in edits {
+                let n = binary.len();
+                binary[at % n] = byte;
+            }
+            let _ = parse_surface(&binary);
         }
 
         #[test]

@@ -27,8 +27,8 @@ pub fn parse(bytes: &[u8]) -> Result<Surface, ParseError> {
             "f" => {
                 let corners = read_face(rest, line, surface.points.len())?;
                 let patch = patches.index(&group);
-                for i in 1..corners.len() - 1 {
-                    surface.triangles.push([corners[0], corners[i], corners[i + 1]]);
+                for triangle in scan::fan(&corners) {
+                    surface.triangles.push(triangle);
                     surface.triangle_patch.push(patch);
                 }
             }

@@ -22,9 +22,7 @@ pub fn parse(bytes: &[u8]) -> Result<Surface, ParseError> {
     for k in 0..face_count {
         let (line, content) = lines.next().ok_or_else(|| truncated(last_line, "faces", k, face_count))?;
         let corners = read_face(content, line, vertex_count)?;
-        for i in 1..corners.len() - 1 {
-            surface.triangles.push([corners[0], corners[i], corners[i + 1]]);
-        }
+        surface.triangles.extend(scan::fan(&corners));
         last_line = line;
     }
     if let Some((line, _)) = lines.next() {

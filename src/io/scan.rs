@@ -7,10 +7,15 @@ use std::str::FromStr;
 use super::ParseError;
 use crate::surface::Surface;
 
-/// The file as text. Bytes that are not UTF-8 become U+FFFD (they can only matter in names and
-/// comments; anywhere else the token that holds them fails to parse, with its line).
+/// The file as text, without a UTF-8 byte-order mark. Bytes that are not UTF-8 become U+FFFD
+/// (they can only matter in names and comments; anywhere else the token that holds them fails
+/// to parse, with its line).
 pub(crate) fn text(bytes: &[u8]) -> Cow<'_, str> {
-    String::from_utf8_lossy(bytes)
+    String::from_utf8_lossy(without_byte_order_mark(bytes))
+}
+
+pub(crate) fn without_byte_order_mark(bytes: &[u8]) -> &[u8] {
+    bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes)
 }
 
 /// The non-empty lines of `text` with their 1-based numbers, trimmed, each cut at `comment`.
@@ -46,7 +51,7 @@ pub(crate) fn line_point(text: &str, line: usize, what: &str) -> Result<[f64; 3]
         let token = tokens
             .next()
             .ok_or_else(|| ParseError::at_line(line, format!("{what} needs 3 coordinates, found {i}")))?;
-        *coordinate = parse_f64(token, line, &format!("a coordinate of {what}"))?;
+        *coordinate = parse_f64(token, line, what)?;
     }
     Ok(p)
 }
@@ -80,6 +85,12 @@ pub(crate) fn bad_vertex(value: i64, count: usize, numbering: &str) -> String {
     format!("vertex index {value} out of range: the file has {count} vertices, numbered {numbering}")
 }
 
+/// Polygon `corners` as a fan of triangles from its first corner (the polygons of these formats
+/// are planar and convex in practice); nothing for fewer than 3 corners.
+pub(crate) fn fan(corners: &[u32]) -> impl Iterator<Item = [u32; 3]> + '_ {
+    corners.windows(2).skip(1).map(move |edge| [corners[0], edge[0], edge[1]])
+}
+
 /// Last step of every reader: drop the points no triangle uses, and refuse an empty surface.
 pub(crate) fn finish(mut surface: Surface) -> Result<Surface, ParseError> {
     if surface.triangles.is_empty() {
@@ -94,14 +105,15 @@ pub(crate) fn finish(mut surface: Surface) -> Result<Surface, ParseError> {
 #[derive(Clone, Debug)]
 pub(crate) struct Tokens<'a> {
     rest: &'a str,
-    line: usize,
+    /// The line `rest` starts on.
+    rest_line: usize,
     last_token_line: usize,
     comment: Option<char>,
 }
 
 impl<'a> Tokens<'a> {
     pub fn new(text: &'a str, comment: Option<char>) -> Self {
-        Tokens { rest: text, line: 1, last_token_line: 1, comment }
+        Tokens { rest: text, rest_line: 1, last_token_line: 1, comment }
     }
 
     /// The line of the last token returned: where an unexpected end of file is reported.
@@ -114,7 +126,7 @@ impl<'a> Tokens<'a> {
         loop {
             let trimmed = self.rest.trim_start_matches(|c: char| c.is_whitespace() && c != '\n');
             if let Some(after) = trimmed.strip_prefix('\n') {
-                self.line += 1;
+                self.rest_line += 1;
                 self.rest = after;
             } else if self.comment.is_some_and(|c| trimmed.starts_with(c)) {
                 self.rest = &trimmed[trimmed.find('\n').unwrap_or(trimmed.len())..];
@@ -132,7 +144,7 @@ impl<'a> Tokens<'a> {
             Some(comment_start) => comment_start,
             None => end,
         };
-        (end > 0).then(|| (self.line, &self.rest[..end]))
+        (end > 0).then(|| (self.rest_line, &self.rest[..end]))
     }
 
     pub fn next_token(&mut self) -> Option<(usize, &'a str)> {
@@ -185,7 +197,7 @@ impl<'a> Tokens<'a> {
     }
 
     /// The rest of the current line (comment included), trimmed; the tokens go on at the next
-    /// line. Must follow `next_token`/`expect` on that line.
+    /// line. Must follow `next_token`/`require` on that line.
     pub fn rest_of_line(&mut self) -> &'a str {
         let end = self.rest.find('\n').unwrap_or(self.rest.len());
         let rest = &self.rest[..end];
@@ -335,6 +347,8 @@ mod tests {
         assert_eq!(vertex_index(0, 1, 3), None);
         assert_eq!(vertex_index(i64::MIN, 1, 3), None);
         assert_eq!(capacity(1 << 40, 100, 10), 10);
+        assert_eq!(fan(&[4, 5, 6, 7]).collect::<Vec<_>>(), vec![[4, 5, 6], [4, 6, 7]]);
+        assert_eq!(fan(&[4, 5]).count(), 0);
     }
 
     #[test]

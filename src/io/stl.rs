@@ -16,8 +16,8 @@ const BINARY_RECORD: usize = 50;
 /// parse as ASCII and its size is exactly that of a binary STL (some binary exporters put
 /// `solid` in the header).
 pub fn parse(bytes: &[u8]) -> Result<Surface, ParseError> {
-    let text_start = bytes.strip_prefix(b"\xEF\xBB\xBF").unwrap_or(bytes).trim_ascii_start();
-    if !text_start.get(..5).is_some_and(|start| start.eq_ignore_ascii_case(b"solid")) {
+    let start = scan::without_byte_order_mark(bytes).trim_ascii_start();
+    if !start.get(..5).is_some_and(|start| start.eq_ignore_ascii_case(b"solid")) {
         return parse_binary(bytes);
     }
     match parse_ascii(&scan::text(bytes)) {
@@ -295,6 +295,14 @@ endsolid
             Location::Line(19),
             "expected 'solid', found 'junk'",
         );
+    }
+
+    #[test]
+    fn byte_order_mark_and_windows_line_ends_are_text() {
+        let text = format!("\u{feff}{}", TWO_SOLIDS.replace('\n', "\r\n"));
+        let s = parse(text.as_bytes()).unwrap();
+        assert_eq!(s.patch_names, vec!["top", "solid_2"]);
+        assert_error(parse, text.replace("endloop", "end"), Location::Line(7), "found 'end'");
     }
 
     #[test]
