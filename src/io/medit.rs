@@ -435,13 +435,13 @@ End
     fn malformed_ascii_names_the_line() {
         assert_error(
             parse_surface,
-            &PYRAMID.replace("3 4 5 1", "3 4 6 1"),
+            PYRAMID.replace("3 4 5 1", "3 4 6 1"),
             Location::Line(18),
             "triangle: vertex index 6 out of range",
         );
         assert_error(
             parse_surface,
-            &PYRAMID.replace("0.5 0.5 1 7", "0.5 0.5 x 7"),
+            PYRAMID.replace("0.5 0.5 1 7", "0.5 0.5 x 7"),
             Location::Line(10),
             "bad number 'x'",
         );
@@ -453,20 +453,20 @@ End
         );
         assert_error(
             parse_surface,
-            &PYRAMID.replace("dimension\n3", "Dimension 2"),
+            PYRAMID.replace("dimension\n3", "Dimension 2"),
             Location::Line(3),
             "dimension 2",
         );
-        assert_error(parse_surface, &PYRAMID.replace("Vertices", "Vertexes"), Location::File, "no Vertices");
+        assert_error(parse_surface, PYRAMID.replace("Vertices", "Vertexes"), Location::File, "no Vertices");
         assert_error(
             parse_surface,
-            &PYRAMID.replace("Corners 1 5", "Triangles 0"),
+            PYRAMID.replace("Corners 1 5", "Triangles 0"),
             Location::Line(14),
             "a second Triangles section",
         );
         assert_error(
             parse_surface,
-            &PYRAMID.replace("Vertices 5", "Vertices -5"),
+            PYRAMID.replace("Vertices 5", "Vertices -5"),
             Location::Line(5),
             "negative vertex count",
         );

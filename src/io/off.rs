@@ -171,19 +171,19 @@ mod tests {
         );
         assert_error(
             parse,
-            &SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3 5"),
+            SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3 5"),
             Location::Line(12),
             "vertex index 5 out of range: the file has 5 vertices",
         );
-        assert_error(parse, &SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3"), Location::Line(12), "lists only 2");
-        assert_error(parse, &SQUARE_PYRAMID.replace("3 2 3 4", "2 2 3"), Location::Line(12), "at least 3");
+        assert_error(parse, SQUARE_PYRAMID.replace("3 2 3 4", "3 2 3"), Location::Line(12), "lists only 2");
+        assert_error(parse, SQUARE_PYRAMID.replace("3 2 3 4", "2 2 3"), Location::Line(12), "at least 3");
         assert_error(
             parse,
-            &SQUARE_PYRAMID.replace("1 1 0", "1 1"),
+            SQUARE_PYRAMID.replace("1 1 0", "1 1"),
             Location::Line(6),
             "needs 3 coordinates, found 2",
         );
-        assert_error(parse, &format!("{SQUARE_PYRAMID}3 0 1 2\n"), Location::Line(14), "after the 5 faces");
+        assert_error(parse, format!("{SQUARE_PYRAMID}3 0 1 2\n"), Location::Line(14), "after the 5 faces");
         assert_error(parse, "4OFF\n1 1 0\n", Location::Line(1), "not supported");
         assert_error(parse, "PLY\n", Location::Line(1), "not an OFF file");
         assert_error(parse, "OFF\n3 x 0\n", Location::Line(2), "bad integer 'x'");

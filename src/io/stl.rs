@@ -261,19 +261,19 @@ endsolid
         assert_error(parse, &missing_vertex, Location::Line(6), "expected 'vertex', found 'endloop'");
         assert_error(
             parse,
-            &TWO_SOLIDS.replacen("vertex 1 0 0", "vertex 1 0x 0", 1),
+            TWO_SOLIDS.replacen("vertex 1 0 0", "vertex 1 0x 0", 1),
             Location::Line(5),
             "bad number '0x'",
         );
         assert_error(
             parse,
-            &TWO_SOLIDS.replacen("    endloop\n", "", 1),
+            TWO_SOLIDS.replacen("    endloop\n", "", 1),
             Location::Line(7),
             "expected 'endloop', found 'endfacet'",
         );
         assert_error(
             parse,
-            &TWO_SOLIDS.replacen("  endfacet\n", "", 1),
+            TWO_SOLIDS.replacen("  endfacet\n", "", 1),
             Location::Line(8),
             "expected 'endfacet', found 'endsolid'",
         );
@@ -291,7 +291,7 @@ endsolid
         );
         assert_error(
             parse,
-            &format!("{TWO_SOLIDS}junk"),
+            format!("{TWO_SOLIDS}junk"),
             Location::Line(19),
             "expected 'solid', found 'junk'",
         );

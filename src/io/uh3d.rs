@@ -178,23 +178,23 @@ mod tests {
     fn malformed_lines_are_named() {
         assert_error(
             parse,
-            &TETRA.replace("4, 2, 3, 4, 2", "4, 2, 3, 9, 2"),
+            TETRA.replace("4, 2, 3, 4, 2", "4, 2, 3, 9, 2"),
             Location::Line(10),
             "vertex index 9 out of range",
         );
         assert_error(
             parse,
-            &TETRA.replace("3, 0., 1., 0.", "7, 0., 1., 0."),
+            TETRA.replace("3, 0., 1., 0.", "7, 0., 1., 0."),
             Location::Line(5),
             "node id 7 where 3 was expected",
         );
         assert_error(
             parse,
-            &TETRA.replace("3, 0., 1., 0.", "3, 0., 1."),
+            TETRA.replace("3, 0., 1., 0.", "3, 0., 1."),
             Location::Line(5),
             "expected 'id, x, y, z'",
         );
-        assert_error(parse, &TETRA.replace("1., 0.\n", "1., zero\n"), Location::Line(5), "bad number 'zero'");
+        assert_error(parse, TETRA.replace("1., 0.\n", "1., zero\n"), Location::Line(5), "bad number 'zero'");
         assert_error(
             parse,
             &TETRA[..TETRA.find("3, 1, 4").unwrap()],
@@ -203,7 +203,7 @@ mod tests {
         );
         assert_error(
             parse,
-            &format!("{TETRA}more\n"),
+            format!("{TETRA}more\n"),
             Location::Line(14),
             "unexpected line after the triangles",
         );
