@@ -315,3 +315,16 @@ proptest! {
         prop_assert_eq!(r.validity.invalid_cells, 1);
     }
 }
+
+/// `cargo test --release -- --ignored one_million_cells --nocapture` prints the time to check
+/// about a million cells of every kind.
+#[test]
+#[ignore]
+fn one_million_cells() {
+    let splits = |c: [usize; 3]| CubeSplit::ALL[(c[0] / 8 + c[1] / 8 + c[2] / 8) % 4];
+    let mesh = cube_grid([60, 60, 60], DVec3::ONE, &splits, &|_| 0);
+    let t = std::time::Instant::now();
+    let r = check(&mesh);
+    println!("{} cells checked in {:.2} s\n{r}", mesh.cell_count(), t.elapsed().as_secs_f64());
+    assert!(r.is_valid());
+}
