@@ -5,6 +5,9 @@
 //! positive enclosed volume (normals point into the fluid for an external body), no triangle is
 //! degenerate and no two triangles intersect except at shared edges/vertices.
 
+pub mod topology;
+pub mod validate;
+
 use crate::geometry::{triangle_area_vector, Aabb, DVec3};
 
 /// A triangle surface: points, triangles (counter-clockwise seen from the fluid, so the
