@@ -132,9 +132,7 @@ fn segments_intersect_2d(p: [f64; 2], q: [f64; 2], r: [f64; 2], s: [f64; 2]) -> 
     let (o1, o2) = (orient2d(p, q, r), orient2d(p, q, s));
     if o1 == Sign::Zero && o2 == Sign::Zero {
         // Collinear: they meet iff their extents overlap along both coordinates.
-        return (0..2).all(|k| {
-            p[k].min(q[k]) <= r[k].max(s[k]) && r[k].min(s[k]) <= p[k].max(q[k])
-        });
+        return (0..2).all(|k| p[k].min(q[k]) <= r[k].max(s[k]) && r[k].min(s[k]) <= p[k].max(q[k]));
     }
     o1 != o2 && orient2d(r, s, p) != orient2d(r, s, q)
 }
@@ -312,6 +310,31 @@ mod tests {
             prop_assert_eq!(triangles_intersect(t, [u[2], u[1], u[0]]), r);
             prop_assert_eq!(triangles_intersect([u[2], u[0], u[1]], [t[0], t[2], t[1]]), r);
         }
+
+        /// The shared-vertex and shared-edge tests do not depend on which triangle comes first
+        /// or on the order of the other corners (integer grid: many exact coplanar cases).
+        #[test]
+        fn shared_corner_tests_are_symmetric(
+            c in proptest::array::uniform12(0i32..3),
+            flat in proptest::bool::ANY,
+        ) {
+            let z = |k: usize| if flat { 0.0 } else { f64::from(c[k]) };
+            let p = |k: usize| v(f64::from(c[k]), f64::from(c[k + 1]), z(k + 2));
+            let (o, a, b, d) = (p(0), p(3), p(6), p(9));
+            let e = v(f64::from(c[2]), f64::from(c[5]), z(8));
+            if !(nondegenerate([o, a, b]) && nondegenerate([o, d, e])) {
+                return Ok(());
+            }
+            let r = meet_beyond_shared_vertex(o, a, b, d, e);
+            prop_assert_eq!(meet_beyond_shared_vertex(o, b, a, d, e), r);
+            prop_assert_eq!(meet_beyond_shared_vertex(o, d, e, a, b), r);
+            prop_assert_eq!(meet_beyond_shared_vertex(o, e, d, b, a), r);
+            if nondegenerate([o, a, d]) {
+                let fold = folds_over_shared_edge(o, a, b, d);
+                prop_assert_eq!(folds_over_shared_edge(a, o, b, d), fold);
+                prop_assert_eq!(folds_over_shared_edge(o, a, d, b), fold);
+            }
+        }
     }
 
     /// Reference for integer triangles: closed triangles are disjoint iff their projections on
@@ -319,13 +342,10 @@ mod tests {
     /// edge normals that separate coplanar triangles) are disjoint. Exact in i64.
     fn separating_axis_exists(a: [i32; 9], b: [i32; 9]) -> bool {
         type V = [i64; 3];
-        let pts = |c: [i32; 9]| -> [V; 3] {
-            [0, 3, 6].map(|k| [c[k], c[k + 1], c[k + 2]].map(i64::from))
-        };
+        let pts = |c: [i32; 9]| -> [V; 3] { [0, 3, 6].map(|k| [c[k], c[k + 1], c[k + 2]].map(i64::from)) };
         let sub = |p: V, q: V| [p[0] - q[0], p[1] - q[1], p[2] - q[2]];
-        let cross = |p: V, q: V| {
-            [p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]]
-        };
+        let cross =
+            |p: V, q: V| [p[1] * q[2] - p[2] * q[1], p[2] * q[0] - p[0] * q[2], p[0] * q[1] - p[1] * q[0]];
         let dot = |p: V, q: V| p[0] * q[0] + p[1] * q[1] + p[2] * q[2];
         let (t, u) = (pts(a), pts(b));
         let edges = |t: [V; 3]| [sub(t[1], t[0]), sub(t[2], t[1]), sub(t[0], t[2])];
@@ -335,8 +355,8 @@ mod tests {
         for i in 0..3 {
             axes.push(cross(nt, et[i]));
             axes.push(cross(nu, eu[i]));
-            for j in 0..3 {
-                axes.push(cross(et[i], eu[j]));
+            for &edge in &eu {
+                axes.push(cross(et[i], edge));
             }
         }
         let range = |t: [V; 3], l: V| {

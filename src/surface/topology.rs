@@ -146,13 +146,13 @@ impl Topology {
         let mut label = vec![u32::MAX; triangle_count];
         let mut shell_of_root = vec![u32::MAX; triangle_count];
         let mut shells = 0;
-        for t in 0..triangle_count {
+        for (t, shell) in label.iter_mut().enumerate() {
             let root = find(&mut parent, t as u32) as usize;
             if shell_of_root[root] == u32::MAX {
                 shell_of_root[root] = shells;
                 shells += 1;
             }
-            label[t] = shell_of_root[root];
+            *shell = shell_of_root[root];
         }
         label
     }
@@ -183,8 +183,7 @@ impl Topology {
         self.count_shell_vertices(&mut shells);
         for shell in &mut shells {
             shell.manifold &= shell.closed;
-            shell.euler_characteristic =
-                shell.vertices as i64 - shell.edges as i64 + shell.triangles as i64;
+            shell.euler_characteristic = shell.vertices as i64 - shell.edges as i64 + shell.triangles as i64;
             let twice_genus = 2 - shell.euler_characteristic;
             if shell.manifold && twice_genus >= 0 && twice_genus % 2 == 0 {
                 shell.genus = u32::try_from(twice_genus / 2).ok();
@@ -287,7 +286,8 @@ fn group_by_key_with(keys: &[u32], items: &[u32], key_count: usize) -> (Vec<u32>
     (start, grouped)
 }
 
-fn find(parent: &mut [u32], mut x: u32) -> u32 {
+/// Root of `x` in a union-find forest (with path halving).
+pub(crate) fn find(parent: &mut [u32], mut x: u32) -> u32 {
     while parent[x as usize] != x {
         let grandparent = parent[parent[x as usize] as usize];
         parent[x as usize] = grandparent;
@@ -297,7 +297,7 @@ fn find(parent: &mut [u32], mut x: u32) -> u32 {
 }
 
 /// Join the sets of `a` and `b`; false when they were already one set.
-fn union(parent: &mut [u32], a: u32, b: u32) -> bool {
+pub(crate) fn union(parent: &mut [u32], a: u32, b: u32) -> bool {
     let (ra, rb) = (find(parent, a), find(parent, b));
     if ra == rb {
         return false;
@@ -340,7 +340,13 @@ pub(crate) mod tests {
     }
 
     /// The face of voxel `c` on side `dir` of `axis`, as two triangles with outward normal.
-    fn add_quad(surface: &mut Surface, index: &mut HashMap<[i32; 3], u32>, c: [i32; 3], axis: usize, dir: i32) {
+    fn add_quad(
+        surface: &mut Surface,
+        index: &mut HashMap<[i32; 3], u32>,
+        c: [i32; 3],
+        axis: usize,
+        dir: i32,
+    ) {
         let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
         let corner = |du: i32, dw: i32| {
             let mut p = c;

@@ -103,7 +103,7 @@ impl<T: fmt::Display> fmt::Display for Examples<T> {
 pub enum ValidationError {
     #[error("empty surface: it has no triangles")]
     Empty,
-    #[error("{} refer to vertex ids beyond the {vertex_count} vertices of the surface, {examples}",
+    #[error("{} with vertex ids beyond the {vertex_count} vertices of the surface, {examples}",
         count(.examples.total, "triangle"))]
     VertexIndexOutOfRange { vertex_count: usize, examples: Examples<TriangleCorners> },
     #[error("non-finite coordinates (NaN or infinity) at {}, {examples}", count(.examples.total, "vertex"))]
@@ -126,7 +126,8 @@ pub enum ValidationError {
     #[error("inconsistent orientation: {} used in the same direction by both of its triangles (their \
         normals point to opposite sides), {examples}", count(.examples.total, "edge"))]
     InconsistentOrientation { examples: Examples<EdgeAt> },
-    #[error("self-intersecting surface: {} intersect, {examples}", count(.examples.total, "pair of triangles"))]
+    #[error("self-intersecting surface: {} intersect, {examples}",
+        count(.examples.total, "pair of triangles"))]
     SelfIntersections { examples: Examples<TrianglePair> },
     #[error("inverted surface: {} enclose negative volume (normals point into the shell), {examples}",
         count(.examples.total, "shell"))]
@@ -149,7 +150,7 @@ fn count(n: usize, noun: &str) -> String {
 }
 
 /// A coordinate with about 7 significant digits, without exponent for usual magnitudes.
-fn format_coordinate(x: f64) -> String {
+pub(crate) fn format_coordinate(x: f64) -> String {
     if x == 0.0 || (1e-4..1e7).contains(&x.abs()) {
         format!("{}", x as f32)
     } else {
@@ -304,8 +305,10 @@ pub fn validate(
     if options.self_intersections {
         describe.check_self_intersections()?;
     }
+    let unused = describe.unused_vertices(&topology);
     let mut shells = measure_shells(surface, &topology);
-    let (flipped_shells, warnings) = orient_shells_outward(surface, &topology, &mut shells, options)?;
+    let (flipped_shells, mut warnings) = orient_shells_outward(surface, &topology, &mut shells, options)?;
+    warnings.extend(unused);
     nest_shells(surface, &topology, &mut shells);
     Ok(ValidationReport { shells, flipped_shells, warnings, seconds: start.elapsed().as_secs_f64() })
 }
@@ -396,6 +399,16 @@ impl Describe<'_> {
         }
         let examples = self.examples(&pairs, |(a, b)| self.pair(a, b));
         Err(ValidationError::SelfIntersections { examples })
+    }
+
+    /// A warning about vertices of no triangle (they are ignored).
+    fn unused_vertices(&self, topo: &Topology) -> Option<String> {
+        let unused = filter_ids(self.surface.points.len(), |v| topo.vertex_triangles(v).is_empty());
+        if unused.is_empty() {
+            return None;
+        }
+        let examples = self.examples(&unused, |v| self.vertex(v));
+        Some(format!("{} used by no triangle (ignored), {examples}", count(unused.len(), "vertex")))
     }
 
     fn examples<I: Copy, T>(&self, ids: &[I], describe: impl Fn(I) -> T) -> Examples<T> {
@@ -512,13 +525,14 @@ fn envelope(g: &GeomWithData<Rectangle<[f64; 3]>, u32>) -> AABB<[f64; 3]> {
 fn triangle_pair_intersects(surface: &Surface, a: u32, b: u32) -> bool {
     let (ta, tb) = (surface.triangles[a as usize], surface.triangles[b as usize]);
     let p = |v: u32| surface.points[v as usize];
-    let mut shared = Vec::with_capacity(3);
-    for i in 0..3 {
-        if let Some(j) = tb.iter().position(|&v| v == ta[i]) {
-            shared.push((i, j));
+    let (mut shared, mut count) = ([(0, 0); 3], 0);
+    for (i, corner) in ta.iter().enumerate() {
+        if let Some(j) = tb.iter().position(|v| v == corner) {
+            shared[count] = (i, j);
+            count += 1;
         }
     }
-    match shared[..] {
+    match shared[..count] {
         [] => triangles_intersect(ta.map(p), tb.map(p)),
         [(i, j)] => meet_beyond_shared_vertex(
             p(ta[i]),
@@ -612,7 +626,9 @@ fn nest_shells(surface: &Surface, topology: &Topology, shells: &mut [ShellReport
         let probe = surface.points[surface.triangles[shell_triangles(inner)[0] as usize][0] as usize];
         let parent = (0..shells.len())
             .filter(|&outer| outer != inner && contains_point(&shells[outer].bounding_box, probe))
-            .filter(|&outer| point_inside(surface, shell_triangles(outer), &shells[outer].bounding_box, probe))
+            .filter(|&outer| {
+                point_inside(surface, shell_triangles(outer), &shells[outer].bounding_box, probe)
+            })
             .min_by(|&a, &b| shells[a].volume.abs().total_cmp(&shells[b].volume.abs()));
         shells[inner].parent = parent.map(|p| p as u32);
     }
@@ -684,22 +700,27 @@ mod tests {
         surface.triangle_patch.extend(&other.triangle_patch);
     }
 
+    const PHI: f64 = 1.618033988749895;
+
+    #[rustfmt::skip]
+    const ICOSAHEDRON_POINTS: [[f64; 3]; 12] = [
+        [-1.0, PHI, 0.0], [1.0, PHI, 0.0], [-1.0, -PHI, 0.0], [1.0, -PHI, 0.0],
+        [0.0, -1.0, PHI], [0.0, 1.0, PHI], [0.0, -1.0, -PHI], [0.0, 1.0, -PHI],
+        [PHI, 0.0, -1.0], [PHI, 0.0, 1.0], [-PHI, 0.0, -1.0], [-PHI, 0.0, 1.0],
+    ];
+
+    #[rustfmt::skip]
+    const ICOSAHEDRON_TRIANGLES: [[u32; 3]; 20] = [
+        [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
+        [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
+        [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
+    ];
+
     /// An icosahedron subdivided `levels` times, projected on the unit sphere.
     fn icosphere(levels: u32) -> Surface {
-        let g = (1.0 + 5f64.sqrt()) / 2.0;
-        let mut points: Vec<DVec3> = [
-            [-1.0, g, 0.0], [1.0, g, 0.0], [-1.0, -g, 0.0], [1.0, -g, 0.0],
-            [0.0, -1.0, g], [0.0, 1.0, g], [0.0, -1.0, -g], [0.0, 1.0, -g],
-            [g, 0.0, -1.0], [g, 0.0, 1.0], [-g, 0.0, -1.0], [-g, 0.0, 1.0],
-        ]
-        .iter()
-        .map(|&c| DVec3::from_array(c).normalize())
-        .collect();
-        let mut triangles: Vec<[u32; 3]> = vec![
-            [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
-            [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
-            [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
-        ];
+        let mut points: Vec<DVec3> =
+            ICOSAHEDRON_POINTS.iter().map(|&c| DVec3::from_array(c).normalize()).collect();
+        let mut triangles = ICOSAHEDRON_TRIANGLES.to_vec();
         for _ in 0..levels {
             let mut midpoint = std::collections::HashMap::new();
             let mut middle = |a: u32, b: u32, points: &mut Vec<DVec3>| {
@@ -740,6 +761,33 @@ mod tests {
         let mut sphere = icosphere(3);
         let volume = check(&mut sphere).unwrap().shells[0].volume;
         assert!((volume - 4.0 / 3.0 * std::f64::consts::PI).abs() < 0.05, "{volume}");
+    }
+
+    #[test]
+    fn ray_parity_inside_and_outside_a_cube() {
+        let s = cube();
+        let all: Vec<u32> = (0..12).collect();
+        let b = s.bounding_box();
+        for (p, inside) in [
+            ([0.5, 0.5, 0.5], true),
+            ([0.1, 0.9, 0.2], true),
+            ([2.0, 0.0, 0.5], false),
+            ([-1.0, -1.0, -1.0], false),
+            ([0.5, 0.5, 1.5], false),
+        ] {
+            assert_eq!(point_inside(&s, &all, &b, DVec3::from_array(p)), inside, "{p:?}");
+        }
+    }
+
+    #[test]
+    fn unused_vertices_are_a_warning() {
+        let mut s = cube();
+        s.points.push(DVec3::splat(5.0));
+        let report = check(&mut s).unwrap();
+        assert_eq!(
+            report.warnings,
+            vec!["1 vertex used by no triangle (ignored), e.g. vertex 8 at (5, 5, 5)"]
+        );
     }
 
     #[test]
@@ -823,7 +871,8 @@ mod tests {
     #[test]
     fn three_triangles_on_an_edge() {
         // A bipyramid over triangle (0, 1, 2) with that triangle added: its 3 edges have 3 triangles.
-        let points = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.3, 0.3, 1.0), DVec3::new(0.3, 0.3, -1.0)];
+        let points =
+            vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.3, 0.3, 1.0), DVec3::new(0.3, 0.3, -1.0)];
         let triangles = vec![[0, 1, 3], [1, 2, 3], [2, 0, 3], [1, 0, 4], [2, 1, 4], [0, 2, 4], [0, 1, 2]];
         let triangle_patch = vec![0; triangles.len()];
         let mut s = Surface { points, triangles, triangle_patch, patch_names: vec!["p".into()] };
@@ -831,8 +880,13 @@ mod tests {
         let ValidationError::NonManifoldEdges { examples } = &e else { panic!("{e}") };
         assert_eq!(examples.total, 3);
         assert_eq!(examples.first[0].edge, [0, 1]);
-        assert!(e.to_string().contains("edge (0, 1) at (0, 0, 0)-(1, 0, 0) of triangle 0 (patch p), triangle 3 \
-            (patch p) and triangle 6 (patch p)"), "{e}");
+        assert!(
+            e.to_string().contains(
+                "edge (0, 1) at (0, 0, 0)-(1, 0, 0) of triangle 0 (patch p), triangle 3 \
+            (patch p) and triangle 6 (patch p)"
+            ),
+            "{e}"
+        );
         // Two cubes sharing an edge: four triangles on it.
         let e = check(&mut voxel_surface(&[[0, 0, 0], [1, 1, 0]])).unwrap_err();
         let ValidationError::NonManifoldEdges { examples } = &e else { panic!("{e}") };
@@ -848,13 +902,17 @@ mod tests {
         let tet = [[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]];
         let mut triangles = tet.to_vec();
         triangles.extend(tet.iter().map(|t| t.map(|v| v + 3)));
-        let mut s = Surface { points, triangles, triangle_patch: vec![0; 8], patch_names: vec![String::new()] };
+        let mut s =
+            Surface { points, triangles, triangle_patch: vec![0; 8], patch_names: vec![String::new()] };
         assert!(s.enclosed_volume() > 0.0);
         let e = check(&mut s).unwrap_err();
         let ValidationError::NonManifoldVertices { examples } = &e else { panic!("{e}") };
         assert_eq!(examples.total, 1);
         assert_eq!((examples.first[0].vertex.vertex, examples.first[0].fans), (3, 2));
-        assert!(e.to_string().contains("vertex 3 at (0, 0, 1), whose 6 triangles form 2 separate fans"), "{e}");
+        assert!(
+            e.to_string().contains("vertex 3 at (0, 0, 1), whose 6 triangles form 2 separate fans"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -887,11 +945,11 @@ mod tests {
     fn folded_pair_intersects() {
         // Move one corner of the top face across the face's diagonal: its two triangles fold.
         let mut s = cube();
-        let top: Vec<usize> = (0..s.triangles.len())
-            .filter(|&t| s.triangle_points(t).iter().all(|p| p.z == 1.0))
-            .collect();
+        let top: Vec<usize> =
+            (0..s.triangles.len()).filter(|&t| s.triangle_points(t).iter().all(|p| p.z == 1.0)).collect();
         let [t0, t1] = [top[0], top[1]];
-        let diagonal: Vec<u32> = s.triangles[t0].iter().copied().filter(|v| s.triangles[t1].contains(v)).collect();
+        let diagonal: Vec<u32> =
+            s.triangles[t0].iter().copied().filter(|v| s.triangles[t1].contains(v)).collect();
         let lone = s.triangles[t1].iter().copied().find(|v| !diagonal.contains(v)).unwrap();
         let other = s.triangles[t0].iter().copied().find(|v| !diagonal.contains(v)).unwrap();
         let mid = 0.5 * (s.points[diagonal[0] as usize] + s.points[diagonal[1] as usize]);
@@ -925,14 +983,18 @@ mod tests {
         let e = check(&mut s).unwrap_err();
         let ValidationError::DegenerateTriangles { examples } = &e else { panic!("{e}") };
         assert_eq!(examples.first[0].triangle.triangle, t as u32);
-        assert!(e.to_string().contains(&format!("triangle {t} (patch wall) with vertices ({a}, {b}, {c})")), "{e}");
+        assert!(
+            e.to_string().contains(&format!("triangle {t} (patch wall) with vertices ({a}, {b}, {c})")),
+            "{e}"
+        );
         let mut repeated = cube();
         repeated.triangles[7][2] = repeated.triangles[7][0];
         let e = check(&mut repeated).unwrap_err();
         assert!(e.to_string().starts_with("1 degenerate triangle with zero area"), "{e}");
         // A sliver with a tiny but non-zero area is valid.
         let mut sliver = cube();
-        sliver.points[b as usize] = 0.5 * (sliver.points[a as usize] + sliver.points[c as usize]) + DVec3::splat(1e-9);
+        sliver.points[b as usize] =
+            0.5 * (sliver.points[a as usize] + sliver.points[c as usize]) + DVec3::splat(1e-9);
         assert!(!is_degenerate(&sliver, t));
     }
 
@@ -945,7 +1007,10 @@ mod tests {
         let e = check(&mut s).unwrap_err();
         let ValidationError::DuplicateTriangles { examples } = &e else { panic!("{e}") };
         assert_eq!(examples.total, 1);
-        assert!(e.to_string().contains("triangle 4 (patch wall)") && e.to_string().contains("triangle 12"), "{e}");
+        assert!(
+            e.to_string().contains("triangle 4 (patch wall)") && e.to_string().contains("triangle 12"),
+            "{e}"
+        );
     }
 
     #[test]
@@ -953,7 +1018,10 @@ mod tests {
         let mut s = cube();
         s.triangles[2][1] = 100;
         let e = check(&mut s).unwrap_err();
-        assert!(e.to_string().contains("beyond the 8 vertices") && e.to_string().contains("triangle 2"), "{e}");
+        assert!(
+            e.to_string().contains("beyond the 8 vertices") && e.to_string().contains("triangle 2"),
+            "{e}"
+        );
         assert_eq!(check(&mut Surface::default()).unwrap_err(), ValidationError::Empty);
     }
 }
