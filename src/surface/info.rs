@@ -60,37 +60,31 @@ impl SurfaceInfo {
         let mut checked = surface.clone();
         let outcome = validate(&mut checked, &ValidationOptions::default());
         let topology = Topology::new(&checked);
-        let (validation, shells, features) = match outcome {
+        let mut shells: Vec<ShellInfo> = topology
+            .shells
+            .iter()
+            .map(|s| ShellInfo {
+                triangles: s.triangles,
+                vertices: s.vertices,
+                genus: s.genus,
+                volume: None,
+                parent: None,
+            })
+            .collect();
+        let (validation, features) = match outcome {
             Ok(report) => {
-                let shells = report
-                    .shells
-                    .iter()
-                    .map(|s| ShellInfo {
-                        triangles: s.triangles,
-                        vertices: s.vertices,
-                        genus: s.genus,
-                        volume: Some(s.volume),
-                        parent: s.parent,
-                    })
-                    .collect();
+                // Validation measured the same shells (flipping does not change connectivity).
+                for (shell, measured) in shells.iter_mut().zip(&report.shells) {
+                    shell.volume = Some(measured.volume);
+                    shell.parent = measured.parent;
+                }
                 let features = Features::compute(&checked, &topology, feature_angle_deg).counts;
-                let summary = ValidationSummary::Valid { warnings: report.warnings, seconds: report.seconds };
-                (summary, shells, Some(features))
+                (
+                    ValidationSummary::Valid { warnings: report.warnings, seconds: report.seconds },
+                    Some(features),
+                )
             }
-            Err(error) => {
-                let shells = topology
-                    .shells
-                    .iter()
-                    .map(|s| ShellInfo {
-                        triangles: s.triangles,
-                        vertices: s.vertices,
-                        genus: s.genus,
-                        volume: None,
-                        parent: None,
-                    })
-                    .collect();
-                (ValidationSummary::Invalid { error: error.to_string() }, shells, None)
-            }
+            Err(error) => (ValidationSummary::Invalid { error: error.to_string() }, None),
         };
         let bounding_box = surface.bounding_box();
         let (min_edge_length, max_edge_length) = edge_length_range(surface, &topology);

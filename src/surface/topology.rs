@@ -373,19 +373,24 @@ pub(crate) mod tests {
         }
     }
 
-    /// All 8 voxels of the 2x2x2 block except the one at (1, 1, 1).
-    pub fn cube_without_octant() -> Surface {
+    /// The n x n x n block of voxels without the voxel `hole`.
+    pub fn block_without(n: i32, hole: [i32; 3]) -> Surface {
         let mut voxels = Vec::new();
-        for i in 0..2 {
-            for j in 0..2 {
-                for k in 0..2 {
-                    if [i, j, k] != [1, 1, 1] {
+        for i in 0..n {
+            for j in 0..n {
+                for k in 0..n {
+                    if [i, j, k] != hole {
                         voxels.push([i, j, k]);
                     }
                 }
             }
         }
         voxel_surface(&voxels)
+    }
+
+    /// All 8 voxels of the 2x2x2 block except the one at (1, 1, 1).
+    pub fn cube_without_octant() -> Surface {
+        block_without(2, [1, 1, 1])
     }
 
     /// A torus of 8 voxels: the ring of a 3x3 block without its centre.

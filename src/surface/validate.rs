@@ -330,28 +330,18 @@ impl Describe<'_> {
         let out_of_range = filter_ids(s.triangles.len(), |t| {
             s.triangles[t as usize].iter().any(|&v| v as usize >= vertex_count)
         });
-        if !out_of_range.is_empty() {
-            let examples = self.examples(&out_of_range, |t| TriangleCorners {
-                triangle: self.tag(t),
-                vertices: s.triangles[t as usize],
-            });
-            return Err(ValidationError::VertexIndexOutOfRange { vertex_count, examples });
-        }
+        let corners = |t: u32| TriangleCorners { triangle: self.tag(t), vertices: s.triangles[t as usize] };
+        let error = |examples| ValidationError::VertexIndexOutOfRange { vertex_count, examples };
+        self.reject(&out_of_range, corners, error)?;
         let non_finite = filter_ids(s.points.len(), |v| !s.points[v as usize].is_finite());
-        if !non_finite.is_empty() {
-            let examples = self.examples(&non_finite, |v| self.vertex(v));
-            return Err(ValidationError::NonFiniteCoordinates { examples });
-        }
+        let error = |examples| ValidationError::NonFiniteCoordinates { examples };
+        self.reject(&non_finite, |v| self.vertex(v), error)?;
         let degenerate = filter_ids(s.triangles.len(), |t| is_degenerate(s, t as usize));
-        if !degenerate.is_empty() {
-            let examples = self.examples(&degenerate, |t| self.triangle(t));
-            return Err(ValidationError::DegenerateTriangles { examples });
-        }
+        let error = |examples| ValidationError::DegenerateTriangles { examples };
+        self.reject(&degenerate, |t| self.triangle(t), error)?;
         let duplicates = duplicate_triangles(&s.triangles);
-        if !duplicates.is_empty() {
-            let examples = self.examples(&duplicates, |(a, b)| self.pair(a, b));
-            return Err(ValidationError::DuplicateTriangles { examples });
-        }
+        let error = |examples| ValidationError::DuplicateTriangles { examples };
+        self.reject(&duplicates, |(a, b)| self.pair(a, b), error)?;
         Ok(())
     }
 
@@ -359,46 +349,36 @@ impl Describe<'_> {
     fn check_topology(&self, topo: &Topology) -> Result<(), ValidationError> {
         let edge_count = topo.edge_count();
         let open = filter_ids(edge_count, |e| topo.edge_uses(e).len() == 1);
-        if !open.is_empty() {
-            let examples = self.examples(&open, |e| self.edge(topo, e));
-            return Err(ValidationError::OpenEdges { examples });
-        }
+        let error = |examples| ValidationError::OpenEdges { examples };
+        self.reject(&open, |e| self.edge(topo, e), error)?;
         let crowded = filter_ids(edge_count, |e| topo.edge_uses(e).len() > 2);
-        if !crowded.is_empty() {
-            let examples = self.examples(&crowded, |e| self.edge(topo, e));
-            return Err(ValidationError::NonManifoldEdges { examples });
-        }
+        let error = |examples| ValidationError::NonManifoldEdges { examples };
+        self.reject(&crowded, |e| self.edge(topo, e), error)?;
         let mut scratch = FanScratch::default();
         let pinched: Vec<(u32, usize)> = (0..topo.vertex_count() as u32)
             .map(|v| (v, topo.vertex_fan_count(v, &mut scratch)))
             .filter(|&(_, fans)| fans > 1)
             .collect();
-        if !pinched.is_empty() {
-            let examples = self.examples(&pinched, |(v, fans)| VertexFans {
-                vertex: self.vertex(v),
-                triangles: topo.vertex_triangles(v).len(),
-                fans,
-            });
-            return Err(ValidationError::NonManifoldVertices { examples });
-        }
+        let fans = |(v, fans)| VertexFans {
+            vertex: self.vertex(v),
+            triangles: topo.vertex_triangles(v).len(),
+            fans,
+        };
+        let error = |examples| ValidationError::NonManifoldVertices { examples };
+        self.reject(&pinched, fans, error)?;
         let misoriented = filter_ids(edge_count, |e| {
             let uses = topo.edge_uses(e);
             uses[0].forward == uses[1].forward
         });
-        if !misoriented.is_empty() {
-            let examples = self.examples(&misoriented, |e| self.edge(topo, e));
-            return Err(ValidationError::InconsistentOrientation { examples });
-        }
+        let error = |examples| ValidationError::InconsistentOrientation { examples };
+        self.reject(&misoriented, |e| self.edge(topo, e), error)?;
         Ok(())
     }
 
     fn check_self_intersections(&self) -> Result<(), ValidationError> {
         let pairs = intersecting_pairs(self.surface);
-        if pairs.is_empty() {
-            return Ok(());
-        }
-        let examples = self.examples(&pairs, |(a, b)| self.pair(a, b));
-        Err(ValidationError::SelfIntersections { examples })
+        let error = |examples| ValidationError::SelfIntersections { examples };
+        self.reject(&pairs, |(a, b)| self.pair(a, b), error)
     }
 
     /// A warning about vertices of no triangle (they are ignored).
@@ -409,6 +389,19 @@ impl Describe<'_> {
         }
         let examples = self.examples(&unused, |v| self.vertex(v));
         Some(format!("{} used by no triangle (ignored), {examples}", count(unused.len(), "vertex")))
+    }
+
+    /// An error listing `ids` when there are any.
+    fn reject<I: Copy, T>(
+        &self,
+        ids: &[I],
+        describe: impl Fn(I) -> T,
+        error: impl FnOnce(Examples<T>) -> ValidationError,
+    ) -> Result<(), ValidationError> {
+        if ids.is_empty() {
+            return Ok(());
+        }
+        Err(error(self.examples(ids, describe)))
     }
 
     fn examples<I: Copy, T>(&self, ids: &[I], describe: impl Fn(I) -> T) -> Examples<T> {
@@ -595,9 +588,8 @@ fn orient_shells_outward(
         volume: shells[s as usize].volume,
         example: describe.tag(first_triangle(s)),
     };
-    if !options.flip_inverted_shells && !inverted.is_empty() {
-        let examples = describe.examples(&inverted, at);
-        return Err(ValidationError::InvertedShells { examples });
+    if !options.flip_inverted_shells {
+        describe.reject(&inverted, at, |examples| ValidationError::InvertedShells { examples })?;
     }
     let warnings: Vec<String> = inverted
         .iter()
@@ -682,7 +674,7 @@ fn count_crossings(surface: &Surface, triangles: &[u32], p: DVec3, q: DVec3) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::surface::topology::tests::{cube_without_octant, voxel_surface, voxel_torus};
+    use crate::surface::topology::tests::{block_without, cube_without_octant, voxel_surface, voxel_torus};
 
     fn check(surface: &mut Surface) -> Result<ValidationReport, ValidationError> {
         validate(surface, &ValidationOptions::default())
@@ -814,17 +806,7 @@ mod tests {
             assert_eq!(report.warnings.len(), expected.len());
         }
         // A cavity in a block: the cavity's own surface points into the cavity, so it is flipped.
-        let mut voxels = Vec::new();
-        for i in 0..3 {
-            for j in 0..3 {
-                for k in 0..3 {
-                    if [i, j, k] != [1, 1, 1] {
-                        voxels.push([i, j, k]);
-                    }
-                }
-            }
-        }
-        let mut block = voxel_surface(&voxels);
+        let mut block = block_without(3, [1, 1, 1]);
         let report = check(&mut block).unwrap();
         assert_eq!(report.flipped_shells.len(), 1);
         let cavity = report.flipped_shells[0] as usize;
