@@ -11,8 +11,11 @@
 //! triangle surface with named patches) and [`mesh`] (the hybrid volume mesh and its node orders).
 
 pub mod cli;
+pub mod config;
 pub mod geometry;
 pub mod io;
+pub mod layers;
 pub mod mesh;
+pub mod normals;
 pub mod quality;
 pub mod surface;

@@ -9,6 +9,7 @@ pub mod medit;
 pub mod msh;
 pub mod obj;
 pub mod off;
+mod scan;
 pub mod stl;
 pub mod uh3d;
 pub mod vtu;

@@ -63,6 +63,39 @@ impl CellKind {
         }
     }
 
+    /// The corners of the cell as (corner, e1, e2, e3): the three edge neighbours of the corner in
+    /// right-handed order, so `det(e1 - c, e2 - c, e3 - c) > 0` in a valid cell. A pyramid lists its
+    /// four base corners only (its apex has four edges). Same table as `shared/bench/measure.py`.
+    pub fn corners(self) -> &'static [[usize; 4]] {
+        match self {
+            CellKind::Tetrahedron => &[[0, 1, 2, 3], [1, 2, 0, 3], [2, 0, 1, 3], [3, 0, 2, 1]],
+            CellKind::Pyramid => &[[0, 1, 3, 4], [1, 2, 0, 4], [2, 3, 1, 4], [3, 0, 2, 4]],
+            CellKind::Prism => {
+                &[[0, 1, 2, 3], [1, 2, 0, 4], [2, 0, 1, 5], [3, 5, 4, 0], [4, 3, 5, 1], [5, 4, 3, 2]]
+            }
+            CellKind::Hexahedron => &[
+                [0, 1, 3, 4],
+                [1, 2, 0, 5],
+                [2, 3, 1, 6],
+                [3, 0, 2, 7],
+                [4, 7, 5, 0],
+                [5, 4, 6, 1],
+                [6, 5, 7, 2],
+                [7, 6, 4, 3],
+            ],
+        }
+    }
+
+    /// The kind of a first-order Gmsh element type number, if it is a volume cell.
+    pub fn from_gmsh_type(t: i32) -> Option<CellKind> {
+        CellKind::ALL.into_iter().find(|k| k.gmsh_type() == t)
+    }
+
+    /// The kind of a VTK cell type number, if it is one of the four volume cells.
+    pub fn from_vtk_type(t: u8) -> Option<CellKind> {
+        CellKind::ALL.into_iter().find(|k| k.vtk_type() == t)
+    }
+
     /// Gmsh element type number (first order).
     pub fn gmsh_type(self) -> i32 {
         match self {

@@ -257,7 +257,9 @@ mod tests {
     fn cut_cube_info() {
         let info = SurfaceInfo::compute(&cube_without_octant(), 30.0);
         assert_eq!((info.triangles, info.vertices), (48, 26));
-        assert_eq!(info.patches, vec![PatchInfo { name: "wall".into(), triangles: 48 }]);
+        assert_eq!(info.patches.len(), 6);
+        assert!(info.patches.iter().all(|p| p.triangles == 8));
+        assert_eq!(info.patches[0], PatchInfo { name: "xmin".into(), triangles: 8 });
         assert_eq!(info.shells.len(), 1);
         assert_eq!(info.shells[0].volume, Some(7.0));
         assert!((info.diagonal - 12f64.sqrt()).abs() < 1e-12);

@@ -316,76 +316,23 @@ pub fn opposite_vertex(triangle: [u32; 3], edge: [u32; 2]) -> u32 {
 pub(crate) mod tests {
     use super::*;
     use crate::geometry::DVec3;
-    use std::collections::HashMap;
+    use crate::surface::shapes;
 
-    /// The closed surface of a union of unit cubes (voxels at integer positions): one quad
-    /// (two triangles) per face between a voxel and empty space, oriented out of the solid.
-    /// Shared faces cancel; voxels touching along an edge or at a corner give non-manifold input.
-    pub fn voxel_surface(voxels: &[[i32; 3]]) -> Surface {
-        let solid: std::collections::HashSet<[i32; 3]> = voxels.iter().copied().collect();
-        let mut surface = Surface { patch_names: vec!["wall".into()], ..Default::default() };
-        let mut index: HashMap<[i32; 3], u32> = HashMap::new();
-        for &c in voxels {
-            for axis in 0..3 {
-                for dir in [-1, 1] {
-                    let mut n = c;
-                    n[axis] += dir;
-                    if !solid.contains(&n) {
-                        add_quad(&mut surface, &mut index, c, axis, dir);
-                    }
-                }
+    /// The closed surface of a union of unit voxels at the given (non-negative) grid positions.
+    /// Voxels touching along an edge or at a corner give non-manifold input.
+    pub fn voxel_surface(cells: &[[usize; 3]]) -> Surface {
+        let mut dims = [1; 3];
+        for c in cells {
+            for k in 0..3 {
+                dims[k] = dims[k].max(c[k] + 1);
             }
         }
-        surface
-    }
-
-    /// The face of voxel `c` on side `dir` of `axis`, as two triangles with outward normal.
-    fn add_quad(
-        surface: &mut Surface,
-        index: &mut HashMap<[i32; 3], u32>,
-        c: [i32; 3],
-        axis: usize,
-        dir: i32,
-    ) {
-        let (u, w) = ((axis + 1) % 3, (axis + 2) % 3);
-        let corner = |du: i32, dw: i32| {
-            let mut p = c;
-            p[axis] += i32::from(dir > 0);
-            p[u] += du;
-            p[w] += dw;
-            p
-        };
-        // (u, w, axis) is right-handed: counter-clockwise in (u, w) has normal +axis.
-        let mut quad = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)];
-        if dir < 0 {
-            quad.reverse();
-        }
-        let ids = quad.map(|p| {
-            let next = index.len() as u32;
-            *index.entry(p).or_insert_with(|| {
-                surface.points.push(DVec3::new(p[0] as f64, p[1] as f64, p[2] as f64));
-                next
-            })
-        });
-        for tri in [[ids[0], ids[1], ids[2]], [ids[0], ids[2], ids[3]]] {
-            surface.triangles.push(tri);
-            surface.triangle_patch.push(0);
-        }
+        shapes::voxels(dims, 1.0, 1, |i, j, k| cells.contains(&[i, j, k]))
     }
 
     /// The n x n x n block of voxels without the voxel `hole`.
-    pub fn block_without(n: i32, hole: [i32; 3]) -> Surface {
-        let mut voxels = Vec::new();
-        for i in 0..n {
-            for j in 0..n {
-                for k in 0..n {
-                    if [i, j, k] != hole {
-                        voxels.push([i, j, k]);
-                    }
-                }
-            }
-        }
-        voxel_surface(&voxels)
+    pub fn block_without(n: usize, hole: [usize; 3]) -> Surface {
+        shapes::voxels([n; 3], 1.0, 1, |i, j, k| [i, j, k] != hole)
     }
 
     /// All 8 voxels of the 2x2x2 block except the one at (1, 1, 1).
@@ -395,15 +342,7 @@ pub(crate) mod tests {
 
     /// A torus of 8 voxels: the ring of a 3x3 block without its centre.
     pub fn voxel_torus() -> Surface {
-        let mut voxels = Vec::new();
-        for i in 0..3 {
-            for j in 0..3 {
-                if [i, j] != [1, 1] {
-                    voxels.push([i, j, 0]);
-                }
-            }
-        }
-        voxel_surface(&voxels)
+        shapes::voxels([3, 3, 1], 1.0, 1, |i, j, _| [i, j] != [1, 1])
     }
 
     #[test]

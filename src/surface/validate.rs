@@ -674,6 +674,7 @@ fn count_crossings(surface: &Surface, triangles: &[u32], p: DVec3, q: DVec3) -> 
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::surface::shapes;
     use crate::surface::topology::tests::{block_without, cube_without_octant, voxel_surface, voxel_torus};
 
     fn check(surface: &mut Surface) -> Result<ValidationReport, ValidationError> {
@@ -692,47 +693,6 @@ mod tests {
         surface.triangle_patch.extend(&other.triangle_patch);
     }
 
-    const PHI: f64 = 1.618033988749895;
-
-    #[rustfmt::skip]
-    const ICOSAHEDRON_POINTS: [[f64; 3]; 12] = [
-        [-1.0, PHI, 0.0], [1.0, PHI, 0.0], [-1.0, -PHI, 0.0], [1.0, -PHI, 0.0],
-        [0.0, -1.0, PHI], [0.0, 1.0, PHI], [0.0, -1.0, -PHI], [0.0, 1.0, -PHI],
-        [PHI, 0.0, -1.0], [PHI, 0.0, 1.0], [-PHI, 0.0, -1.0], [-PHI, 0.0, 1.0],
-    ];
-
-    #[rustfmt::skip]
-    const ICOSAHEDRON_TRIANGLES: [[u32; 3]; 20] = [
-        [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4],
-        [11, 10, 2], [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8],
-        [3, 8, 9], [4, 9, 5], [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
-    ];
-
-    /// An icosahedron subdivided `levels` times, projected on the unit sphere.
-    fn icosphere(levels: u32) -> Surface {
-        let mut points: Vec<DVec3> =
-            ICOSAHEDRON_POINTS.iter().map(|&c| DVec3::from_array(c).normalize()).collect();
-        let mut triangles = ICOSAHEDRON_TRIANGLES.to_vec();
-        for _ in 0..levels {
-            let mut midpoint = std::collections::HashMap::new();
-            let mut middle = |a: u32, b: u32, points: &mut Vec<DVec3>| {
-                *midpoint.entry((a.min(b), a.max(b))).or_insert_with(|| {
-                    points.push((points[a as usize] + points[b as usize]).normalize());
-                    points.len() as u32 - 1
-                })
-            };
-            let mut finer = Vec::new();
-            for [a, b, c] in triangles {
-                let (ab, bc, ca) =
-                    (middle(a, b, &mut points), middle(b, c, &mut points), middle(c, a, &mut points));
-                finer.extend([[a, ab, ca], [b, bc, ab], [c, ca, bc], [ab, bc, ca]]);
-            }
-            triangles = finer;
-        }
-        let triangle_patch = vec![0; triangles.len()];
-        Surface { points, triangles, triangle_patch, patch_names: vec!["sphere".into()] }
-    }
-
     #[test]
     fn valid_solids() {
         for (name, mut s, genus) in [
@@ -740,7 +700,7 @@ mod tests {
             ("L-block", voxel_surface(&[[0, 0, 0], [1, 0, 0], [0, 1, 0]]), 0),
             ("cut cube", cube_without_octant(), 0),
             ("torus", voxel_torus(), 1),
-            ("sphere", icosphere(3), 0),
+            ("sphere", shapes::icosphere(1.0, 3), 0),
         ] {
             let before = s.triangles.clone();
             let report = check(&mut s).unwrap_or_else(|e| panic!("{name}: {e}"));
@@ -750,7 +710,7 @@ mod tests {
             assert_eq!(s.triangles, before, "{name} unchanged");
             assert!((report.shells[0].volume - s.enclosed_volume()).abs() < 1e-12, "{name}");
         }
-        let mut sphere = icosphere(3);
+        let mut sphere = shapes::icosphere(1.0, 3);
         let volume = check(&mut sphere).unwrap().shells[0].volume;
         assert!((volume - 4.0 / 3.0 * std::f64::consts::PI).abs() < 0.05, "{volume}");
     }
@@ -820,7 +780,7 @@ mod tests {
         s.flip_all();
         let report = check(&mut s).unwrap();
         assert_eq!(report.flipped_shells, vec![0]);
-        assert!(report.warnings[0].contains("shell 0 (12 triangles, e.g. triangle 0 (patch wall))"));
+        assert!(report.warnings[0].contains("shell 0 (12 triangles, e.g. triangle 0 (patch xmin))"));
         assert!(report.warnings[0].contains("flipped"), "{}", report.warnings[0]);
         assert!((s.enclosed_volume() - 1.0).abs() < 1e-12);
         assert_eq!(s.triangles, cube().triangles);
@@ -842,8 +802,10 @@ mod tests {
         assert_eq!(examples.total, 3);
         let message = e.to_string();
         assert!(message.starts_with("open surface: 3 boundary edges ("), "{message}");
-        assert!(message.contains("e.g. edge (0, 3) at (0, 0, 1)-(0, 0, 0) of triangle 1"), "{message}");
-        assert!(message.contains("(patch wall)"), "{message}");
+        assert!(
+            message.contains("e.g. edge (0, 4) at (0, 0, 0)-(1, 0, 0) of triangle 7 (patch zmin)"),
+            "{message}"
+        );
         for edge in &examples.first {
             assert!(edge.edge.iter().all(|v| removed.contains(v)));
             assert_eq!(edge.triangles.len(), 1);
@@ -966,7 +928,7 @@ mod tests {
         let ValidationError::DegenerateTriangles { examples } = &e else { panic!("{e}") };
         assert_eq!(examples.first[0].triangle.triangle, t as u32);
         assert!(
-            e.to_string().contains(&format!("triangle {t} (patch wall) with vertices ({a}, {b}, {c})")),
+            e.to_string().contains(&format!("triangle {t} (patch zmax) with vertices ({a}, {b}, {c})")),
             "{e}"
         );
         let mut repeated = cube();
@@ -990,7 +952,7 @@ mod tests {
         let ValidationError::DuplicateTriangles { examples } = &e else { panic!("{e}") };
         assert_eq!(examples.total, 1);
         assert!(
-            e.to_string().contains("triangle 4 (patch wall)") && e.to_string().contains("triangle 12"),
+            e.to_string().contains("triangle 4 (patch ymin)") && e.to_string().contains("triangle 12"),
             "{e}"
         );
     }

@@ -1,0 +1,25 @@
+#!/usr/bin/env bash
+# Installs what blmesh's build and tests need on a fresh Debian machine with Rust:
+# the system libraries the Gmsh Python wheel loads, and a venv with gmsh + meshio (used by the
+# interoperability tests that read our files back with other tools). Idempotent.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+SUDO=""
+if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
+APT_PACKAGES="python3-venv libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxext6 libfontconfig1"
+missing=""
+for p in $APT_PACKAGES; do
+  dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"
+done
+if [ -n "$missing" ]; then
+  echo "setup: installing Debian packages:$missing"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
+fi
+
+if [ ! -x .venv/bin/python ]; then
+  python3 -m venv .venv
+fi
+.venv/bin/python -c "import gmsh, meshio, numpy" 2>/dev/null || \
+  .venv/bin/pip install -q gmsh==4.15.2 meshio==5.3.5 numpy

@@ -1,0 +1,391 @@
+//! Meshing parameters: the TOML config file, command-line overrides, and their validation.
+//!
+//! Lengths given by the user are absolute (the surface's own units). Anything not given gets a
+//! default relative to the body size (the bounding-box diagonal `D`), so that
+//! `blmesh mesh body.stl -o out.msh` gives a sensible mesh for a body of any scale.
+//!
+//! ```toml
+//! flow = "external"            # or "internal"
+//! farfield = "box"             # or "sphere"; ignored for internal flow
+//! feature_angle = 30.0         # degrees: edges turning more are ridges
+//! fan_angle = 20.0             # degrees: largest angle between neighbouring fan normals
+//! [layers]
+//! first_height = 1.0e-5        # h0
+//! growth = 1.2                 # r: layer k is h0 r^k high
+//! count = 25                   # or: thickness = 0.05, or: count = "auto" (stop at isotropy)
+//! [[patch]]
+//! match = "face9"              # patch name or regex (whole name)
+//! role = "symmetry"            # wall | symmetry | farfield | inlet | outlet | none
+//! first_height = 2.0e-5        # per-patch layer overrides (wall patches)
+//! ```
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+/// Default first-layer height, as a fraction of the bounding-box diagonal.
+pub const DEFAULT_FIRST_HEIGHT_REL: f64 = 1e-3;
+pub const DEFAULT_GROWTH: f64 = 1.2;
+pub const DEFAULT_LAYER_COUNT: u32 = 10;
+pub const DEFAULT_FEATURE_ANGLE: f64 = 30.0;
+pub const DEFAULT_FAN_ANGLE: f64 = 20.0;
+/// More layers than this is certainly a mistake (and a memory blow-up).
+pub const MAX_LAYER_COUNT: u32 = 1000;
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Flow {
+    /// The fluid is outside the surface's shells (a body in a farfield).
+    #[default]
+    External,
+    /// The surface bounds the fluid (a duct): layers grow inward, there is no farfield.
+    Internal,
+}
+
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum FarfieldShape {
+    #[default]
+    Box,
+    Sphere,
+}
+
+/// What a patch is, for the mesher.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Role {
+    /// Viscous wall: gets layers.
+    #[default]
+    Wall,
+    Symmetry,
+    Farfield,
+    Inlet,
+    Outlet,
+    /// Any other boundary without layers.
+    None,
+}
+
+impl Role {
+    pub fn has_layers(self) -> bool {
+        self == Role::Wall
+    }
+}
+
+/// How many layers: a fixed count, or until the cells become isotropic.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum LayerCount {
+    Fixed(u32),
+    Auto,
+}
+
+impl<'de> Deserialize<'de> for LayerCount {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        #[derive(Deserialize)]
+        #[serde(untagged)]
+        enum Raw {
+            Int(i64),
+            Text(String),
+        }
+        match Raw::deserialize(d)? {
+            Raw::Int(n) if (1..=MAX_LAYER_COUNT as i64).contains(&n) => Ok(LayerCount::Fixed(n as u32)),
+            Raw::Int(n) => Err(serde::de::Error::custom(format!(
+                "layer count {n} is out of range 1..={MAX_LAYER_COUNT}"
+            ))),
+            Raw::Text(s) => s.parse().map_err(serde::de::Error::custom),
+        }
+    }
+}
+
+impl std::str::FromStr for LayerCount {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        if s.eq_ignore_ascii_case("auto") {
+            return Ok(LayerCount::Auto);
+        }
+        match s.parse::<u32>() {
+            Ok(n) if (1..=MAX_LAYER_COUNT).contains(&n) => Ok(LayerCount::Fixed(n)),
+            _ => Err(format!("layer count must be 1..={MAX_LAYER_COUNT} or \"auto\", got {s:?}")),
+        }
+    }
+}
+
+/// Layer settings as the user wrote them; every field optional.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct LayerSettings {
+    pub first_height: Option<f64>,
+    pub growth: Option<f64>,
+    pub count: Option<LayerCount>,
+    pub thickness: Option<f64>,
+}
+
+impl LayerSettings {
+    /// Fields set in `over` replace ours.
+    pub fn overridden_by(&self, over: &LayerSettings) -> LayerSettings {
+        LayerSettings {
+            first_height: over.first_height.or(self.first_height),
+            growth: over.growth.or(self.growth),
+            // A count and a thickness exclude each other: the more specific source wins both.
+            count: if over.thickness.is_some() { over.count } else { over.count.or(self.count) },
+            thickness: if over.count.is_some() { over.thickness } else { over.thickness.or(self.thickness) },
+        }
+    }
+}
+
+/// Settings for the patches whose name matches `match` (a regex matched against the whole name).
+#[derive(Clone, Debug, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct PatchRule {
+    #[serde(rename = "match")]
+    pub pattern: String,
+    #[serde(default)]
+    pub role: Option<Role>,
+    #[serde(flatten)]
+    pub layers: LayerSettings,
+}
+
+/// The whole configuration, as read from TOML and overridden by flags.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct Config {
+    #[serde(default)]
+    pub flow: Flow,
+    #[serde(default)]
+    pub farfield: FarfieldShape,
+    pub feature_angle: Option<f64>,
+    pub fan_angle: Option<f64>,
+    #[serde(default)]
+    pub layers: LayerSettings,
+    #[serde(default, rename = "patch")]
+    pub patches: Vec<PatchRule>,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum ConfigError {
+    #[error("{}: cannot read: {source}", path.display())]
+    Io { path: std::path::PathBuf, source: std::io::Error },
+    #[error("{}: {message}", path.display())]
+    Syntax { path: std::path::PathBuf, message: String },
+    #[error("invalid parameter {name} = {value}: {why}")]
+    Parameter { name: String, value: String, why: String },
+    #[error("[[patch]] match = {pattern:?} is not a valid regex: {why}")]
+    Pattern { pattern: String, why: String },
+}
+
+fn bad(name: &str, value: impl ToString, why: &str) -> ConfigError {
+    ConfigError::Parameter { name: name.into(), value: value.to_string(), why: why.into() }
+}
+
+impl Config {
+    pub fn from_toml_file(path: &Path) -> Result<Config, ConfigError> {
+        let text = std::fs::read_to_string(path)
+            .map_err(|source| ConfigError::Io { path: path.to_owned(), source })?;
+        Self::from_toml_str(&text)
+            .map_err(|message| ConfigError::Syntax { path: path.to_owned(), message })
+    }
+
+    pub fn from_toml_str(text: &str) -> Result<Config, String> {
+        toml::from_str(text).map_err(|e| e.to_string())
+    }
+
+    pub fn feature_angle(&self) -> f64 {
+        self.feature_angle.unwrap_or(DEFAULT_FEATURE_ANGLE)
+    }
+
+    pub fn fan_angle(&self) -> f64 {
+        self.fan_angle.unwrap_or(DEFAULT_FAN_ANGLE)
+    }
+
+    /// Check everything that does not depend on the surface.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let fa = self.feature_angle();
+        if !(fa.is_finite() && fa > 0.0 && fa < 180.0) {
+            return Err(bad("feature_angle", fa, "must be between 0 and 180 degrees"));
+        }
+        let fan = self.fan_angle();
+        if !(fan.is_finite() && fan >= 1.0 && fan <= 90.0) {
+            return Err(bad("fan_angle", fan, "must be between 1 and 90 degrees"));
+        }
+        validate_layer_settings("layers", &self.layers)?;
+        for rule in &self.patches {
+            regex::Regex::new(&rule.pattern).map_err(|e| ConfigError::Pattern {
+                pattern: rule.pattern.clone(),
+                why: e.to_string(),
+            })?;
+            validate_layer_settings(&format!("patch {:?}", rule.pattern), &rule.layers)?;
+        }
+        Ok(())
+    }
+
+    /// Role and layer settings of a patch: the last matching `[[patch]]` rule wins.
+    pub fn patch_settings(&self, patch_name: &str) -> (Role, LayerSettings) {
+        let mut role = Role::Wall;
+        let mut layers = self.layers.clone();
+        for rule in &self.patches {
+            let whole = format!("^(?:{})$", rule.pattern);
+            if regex::Regex::new(&whole).is_ok_and(|re| re.is_match(patch_name)) {
+                role = rule.role.unwrap_or(role);
+                layers = layers.overridden_by(&rule.layers);
+            }
+        }
+        (role, layers)
+    }
+}
+
+fn validate_layer_settings(what: &str, s: &LayerSettings) -> Result<(), ConfigError> {
+    let name = |field: &str| format!("{what}.{field}");
+    if let Some(h) = s.first_height {
+        if !(h.is_finite() && h > 0.0) {
+            return Err(bad(&name("first_height"), h, "must be a positive length"));
+        }
+    }
+    if let Some(r) = s.growth {
+        if !(r.is_finite() && (1.0..=5.0).contains(&r)) {
+            return Err(bad(&name("growth"), r, "must be between 1 and 5"));
+        }
+    }
+    if let Some(t) = s.thickness {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(bad(&name("thickness"), t, "must be a positive length"));
+        }
+        if s.count.is_some() {
+            return Err(bad(&name("thickness"), t, "give either a layer count or a thickness, not both"));
+        }
+        if let Some(h) = s.first_height.filter(|&h| t < h) {
+            return Err(bad(&name("thickness"), t, &format!("is thinner than the first layer ({h})")));
+        }
+    }
+    Ok(())
+}
+
+/// The layer stack of one patch, with every value resolved and checked.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct LayerSpec {
+    pub first_height: f64,
+    pub growth: f64,
+    pub count: LayerCount,
+}
+
+impl LayerSpec {
+    /// Resolve user settings against the body size (bounding-box diagonal).
+    pub fn resolve(s: &LayerSettings, body_size: f64) -> Result<LayerSpec, ConfigError> {
+        let first_height = s.first_height.unwrap_or(DEFAULT_FIRST_HEIGHT_REL * body_size);
+        let growth = s.growth.unwrap_or(DEFAULT_GROWTH);
+        let count = match (s.count, s.thickness) {
+            (Some(c), _) => c,
+            (None, Some(t)) => LayerCount::Fixed(layers_for_thickness(first_height, growth, t)?),
+            (None, None) => LayerCount::Fixed(DEFAULT_LAYER_COUNT),
+        };
+        Ok(LayerSpec { first_height, growth, count })
+    }
+
+    /// The layer count, unless it is decided while marching (`count = "auto"`).
+    pub fn fixed_count(&self) -> Option<u32> {
+        match self.count {
+            LayerCount::Fixed(n) => Some(n),
+            LayerCount::Auto => None,
+        }
+    }
+
+    /// Height of layer `k` (0-based).
+    pub fn height(&self, k: u32) -> f64 {
+        self.first_height * self.growth.powi(k as i32)
+    }
+
+    /// Distance from the wall of the top of layer `k - 1` (the sum of the first `k` heights).
+    pub fn distance(&self, k: u32) -> f64 {
+        if self.growth == 1.0 {
+            self.first_height * k as f64
+        } else {
+            self.first_height * (self.growth.powi(k as i32) - 1.0) / (self.growth - 1.0)
+        }
+    }
+}
+
+/// The fewest layers whose total height reaches `thickness`.
+fn layers_for_thickness(h0: f64, r: f64, thickness: f64) -> Result<u32, ConfigError> {
+    if thickness < h0 {
+        return Err(bad("thickness", thickness, &format!("is thinner than the first layer ({h0})")));
+    }
+    let n = if r == 1.0 {
+        (thickness / h0).ceil()
+    } else {
+        ((1.0 + thickness * (r - 1.0) / h0).ln() / r.ln()).ceil()
+    };
+    if n > MAX_LAYER_COUNT as f64 {
+        return Err(bad("thickness", thickness, &format!("needs {n} layers, more than {MAX_LAYER_COUNT}")));
+    }
+    Ok((n as u32).max(1))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn parses_the_documented_example() {
+        let c = Config::from_toml_str(
+            r#"
+            flow = "external"
+            farfield = "box"
+            [layers]
+            first_height = 1.0e-5
+            growth = 1.2
+            count = 25
+            [[patch]]
+            match = "face9"
+            role = "symmetry"
+            [[patch]]
+            match = "fin[0-9]"
+            first_height = 2.0e-5
+            count = "auto"
+            "#,
+        )
+        .unwrap();
+        c.validate().unwrap();
+        assert_eq!(c.patch_settings("face9").0, Role::Symmetry);
+        assert_eq!(c.patch_settings("face90").0, Role::Wall, "match is on the whole name");
+        let (role, fin) = c.patch_settings("fin3");
+        assert_eq!(role, Role::Wall);
+        assert_eq!(fin.first_height, Some(2.0e-5));
+        assert_eq!(fin.count, Some(LayerCount::Auto));
+        assert_eq!(fin.growth, Some(1.2));
+    }
+
+    #[test]
+    fn rejects_impossible_parameters() {
+        let bad_cases = [
+            "[layers]\nfirst_height = -1.0",
+            "[layers]\ngrowth = 0.9",
+            "[layers]\nfirst_height = 1.0\nthickness = 0.5",
+            "[layers]\ncount = 5\nthickness = 0.5",
+            "feature_angle = 200.0",
+            "[[patch]]\nmatch = \"(\"",
+        ];
+        for text in bad_cases {
+            let c = Config::from_toml_str(text).unwrap();
+            assert!(c.validate().is_err(), "accepted: {text}");
+        }
+        assert!(Config::from_toml_str("[layers]\ncount = 0").is_err());
+        assert!(Config::from_toml_str("[layers]\ncount = \"many\"").is_err());
+        assert!(Config::from_toml_str("unknown_key = 1").is_err());
+    }
+
+    #[test]
+    fn thickness_gives_the_fewest_layers_reaching_it() {
+        let s = LayerSettings { first_height: Some(1.0), growth: Some(2.0), thickness: Some(7.0), count: None };
+        let spec = LayerSpec::resolve(&s, 1.0).unwrap();
+        assert_eq!(spec.count, LayerCount::Fixed(3)); // 1 + 2 + 4 = 7
+        assert_eq!(spec.distance(3), 7.0);
+        let s = LayerSettings { thickness: Some(7.5), ..s };
+        assert_eq!(LayerSpec::resolve(&s, 1.0).unwrap().count, LayerCount::Fixed(4));
+    }
+
+    #[test]
+    fn defaults_scale_with_the_body() {
+        let a = LayerSpec::resolve(&LayerSettings::default(), 1.0).unwrap();
+        let b = LayerSpec::resolve(&LayerSettings::default(), 1000.0).unwrap();
+        assert!((b.first_height / a.first_height - 1000.0).abs() < 1e-9);
+        assert_eq!(a.count, b.count);
+    }
+}

@@ -1,0 +1,69 @@
+//! Progress bars (on a terminal only) and stage timings.
+
+use std::io::IsTerminal;
+use std::time::Instant;
+
+use indicatif::{ProgressBar, ProgressStyle};
+use serde::Serialize;
+
+/// Hands out progress bars: visible on a terminal unless quiet, hidden otherwise.
+#[derive(Clone, Copy, Debug)]
+pub struct Progress {
+    visible: bool,
+}
+
+impl Progress {
+    pub fn new(quiet: bool) -> Self {
+        Progress { visible: !quiet && std::io::stderr().is_terminal() }
+    }
+
+    pub fn hidden() -> Self {
+        Progress { visible: false }
+    }
+
+    /// A bar counting `len` steps of work named `what`.
+    pub fn bar(&self, len: u64, what: &str) -> ProgressBar {
+        if !self.visible {
+            return ProgressBar::hidden();
+        }
+        let style = ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} {elapsed}")
+            .unwrap_or_else(|_| ProgressStyle::default_bar())
+            .progress_chars("=> ");
+        ProgressBar::new(len).with_style(style).with_message(what.to_owned())
+    }
+}
+
+/// Wall-clock time of each pipeline stage, in the order they ran.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Timings {
+    pub stages: Vec<StageTime>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct StageTime {
+    pub stage: String,
+    pub seconds: f64,
+}
+
+impl Timings {
+    /// Run `f` as stage `name` and record how long it took.
+    pub fn time<T>(&mut self, name: &str, f: impl FnOnce() -> T) -> T {
+        let start = Instant::now();
+        let out = f();
+        self.stages.push(StageTime { stage: name.to_owned(), seconds: start.elapsed().as_secs_f64() });
+        out
+    }
+
+    pub fn total(&self) -> f64 {
+        self.stages.iter().map(|s| s.seconds).sum()
+    }
+}
+
+impl std::fmt::Display for Timings {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        for s in &self.stages {
+            writeln!(f, "  {:<12} {:>9.3} s", s.stage, s.seconds)?;
+        }
+        write!(f, "  {:<12} {:>9.3} s", "total", self.total())
+    }
+}
