@@ -1,6 +1,7 @@
 //! Geometric vocabulary: the point type and the exact predicates every topological decision uses.
 
 pub mod distance;
+pub mod intersect;
 pub mod predicates;
 
 /// Every coordinate in blmesh is an `f64` 3-vector.

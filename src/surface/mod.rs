@@ -5,6 +5,11 @@
 //! positive enclosed volume (normals point into the fluid for an external body), no triangle is
 //! degenerate and no two triangles intersect except at shared edges/vertices.
 
+pub mod features;
+pub mod info;
+pub mod topology;
+pub mod validate;
+
 use std::collections::HashMap;
 
 use crate::geometry::{triangle_area_vector, Aabb, DVec3};
