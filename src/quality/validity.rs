@@ -7,7 +7,9 @@
 
 use rayon::prelude::*;
 
-use super::measures::{dihedral_range, edge_face_pairs, for_each_subtet, scaled_jacobian, volume, CellPoints};
+use super::measures::{
+    dihedral_range, edge_face_pairs, for_each_subtet, scaled_jacobian, volume, CellPoints,
+};
 use super::report::{CellRef, InvalidCell, KindQuality, EXAMPLES};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
@@ -107,7 +109,13 @@ pub fn check_block(mesh: &VolumeMesh, kind: CellKind) -> BlockResult {
     result
 }
 
-fn check_cell(mesh: &VolumeMesh, cell: CellRef, nodes: &[u32], pairs: &[(usize, usize)], out: &mut BlockResult) {
+fn check_cell(
+    mesh: &VolumeMesh,
+    cell: CellRef,
+    nodes: &[u32],
+    pairs: &[(usize, usize)],
+    out: &mut BlockResult,
+) {
     let kind = cell.kind;
     let Some(x) = gather(&mesh.points, nodes) else {
         out.invalid += 1;

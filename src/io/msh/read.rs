@@ -48,7 +48,7 @@ fn element_type(t: i32) -> Option<ElementType> {
     Some(match t {
         2 => Keep(Shape::Triangle),
         3 => Keep(Shape::Quad),
-        4 | 5 | 6 | 7 => Keep(Shape::Cell(CellKind::from_gmsh_type(t)?)),
+        4..=7 => Keep(Shape::Cell(CellKind::from_gmsh_type(t)?)),
         1 => Skip(2),
         8 => Skip(3),
         15 => Skip(1),
@@ -122,7 +122,8 @@ pub fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
             c.expect("$EndPhysicalNames")?;
             continue;
         }
-        let known = matches!(name, "Entities" | "Nodes" | "Elements") && !(v == Version::V2 && name == "Entities");
+        let known =
+            matches!(name, "Entities" | "Nodes" | "Elements") && !(v == Version::V2 && name == "Entities");
         if !known {
             c.skip_past(&format!("$End{name}"))?;
             continue;
@@ -334,7 +335,9 @@ fn read_elements4(c: &mut Cursor, mesh: &mut RawMesh) -> Result<(), ParseError> 
                 }
                 continue;
             }
-            None => return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file"))),
+            None => {
+                return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file")))
+            }
         };
         let nodes_per = shape.node_count();
         let block = block_for(&mut mesh.blocks, shape, entity, None);
@@ -379,7 +382,9 @@ fn read_elements2(c: &mut Cursor, binary: bool, mesh: &mut RawMesh) -> Result<()
             Some(ElementType::Keep(shape)) => shape.node_count(),
             Some(ElementType::Skip(nodes)) => nodes,
             Some(ElementType::HigherOrder(s)) => return Err(higher_order_error(c, t, s)),
-            None => return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file"))),
+            None => {
+                return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file")))
+            }
         };
         if follow == 0 || follow > n - read {
             return Err(c.error(format!("element header announces {follow} elements, {} remain", n - read)));
