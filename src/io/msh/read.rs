@@ -117,23 +117,17 @@ pub fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
         let Some(v) = version else {
             return Err(c.error(format!("${} before $MeshFormat: not an MSH file", clip(name))));
         };
-        if name == "PhysicalNames" {
-            read_physical_names(&mut c, &mut mesh)?;
-            c.expect("$EndPhysicalNames")?;
-            continue;
-        }
-        let known =
-            matches!(name, "Entities" | "Nodes" | "Elements") && !(v == Version::V2 && name == "Entities");
-        if !known {
-            c.skip_past(&format!("$End{name}"))?;
-            continue;
-        }
         match (name, v) {
-            ("Entities", _) => with_binary(&mut c, binary, |c| read_entities(c, &mut mesh))?,
+            ("PhysicalNames", _) => read_physical_names(&mut c, &mut mesh)?,
+            ("Entities", Version::V4) => with_binary(&mut c, binary, |c| read_entities(c, &mut mesh))?,
             ("Nodes", Version::V4) => with_binary(&mut c, binary, |c| read_nodes4(c, &mut mesh))?,
             ("Elements", Version::V4) => with_binary(&mut c, binary, |c| read_elements4(c, &mut mesh))?,
-            ("Nodes", _) => read_nodes2(&mut c, binary, &mut mesh)?,
-            _ => read_elements2(&mut c, binary, &mut mesh)?,
+            ("Nodes", Version::V2) => read_nodes2(&mut c, binary, &mut mesh)?,
+            ("Elements", Version::V2) => read_elements2(&mut c, binary, &mut mesh)?,
+            _ => {
+                c.skip_past(&format!("$End{name}"))?;
+                continue;
+            }
         }
         c.expect(&format!("$End{name}"))?;
     }
@@ -330,6 +324,7 @@ fn read_elements4(c: &mut Cursor, mesh: &mut RawMesh) -> Result<(), ParseError> 
             }
             Some(ElementType::HigherOrder(s)) => return Err(higher_order_error(c, t, s)),
             None if !c.binary => {
+                c.rest_of_line(); // the block header's line break, then one line per element
                 for _ in 0..n {
                     c.rest_of_line();
                 }

@@ -124,6 +124,19 @@ fn gmsh_41_ascii_with_sparse_tags_and_groups() {
 }
 
 #[test]
+fn unknown_element_types_are_skipped_in_text() {
+    let unknown = "0 1 15 1\n100 5\n0 1 99 2\n200 1 2 3 4 5 6 7\n201 1 2 3 4 5 6 7\n";
+    let mesh = parse_volume(
+        GMSH41.replace("6 7 100 106", "7 9 100 201").replace("0 1 15 1\n100 5\n", unknown).as_bytes(),
+    );
+    assert!(check(&mesh.unwrap()).is_valid());
+    let mesh = parse_volume(
+        GMSH22.replace("7\n1 15 2 0 1 10", "8\n0 99 2 0 1 1 2 3 4 5 6 7\n1 15 2 0 1 10").as_bytes(),
+    );
+    assert!(check(&mesh.unwrap()).is_valid());
+}
+
+#[test]
 fn gmsh_22_ascii() {
     let mesh = parse_volume(GMSH22.as_bytes()).unwrap();
     assert_eq!(mesh.patch_names, ["wall left", "physical_8", "surface_4"]);
