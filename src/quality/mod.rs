@@ -29,13 +29,7 @@ pub fn check(mesh: &VolumeMesh) -> CheckReport {
     );
     let mut volume = 0.0;
     for (kind, block) in CellKind::ALL.into_iter().zip(blocks) {
-        let v = &mut report.validity;
-        v.invalid_cells += block.invalid;
-        v.inverted_corners += block.inverted_corners;
-        v.nonpositive_decomposition += block.nonpositive_subtets;
-        v.nodes_out_of_range += block.nodes_out_of_range;
-        let room = EXAMPLES.saturating_sub(v.examples.len());
-        v.examples.extend(block.examples.into_iter().take(room));
+        report.validity.append(block.validity);
         volume += block.volume;
         *report.quality.get_mut(kind) = block.quality;
     }

@@ -88,6 +88,18 @@ pub struct Validity {
     pub examples: Vec<InvalidCell>,
 }
 
+impl Validity {
+    /// Add the counts of `other` and keep the first examples.
+    pub fn append(&mut self, other: Validity) {
+        self.invalid_cells += other.invalid_cells;
+        self.inverted_corners += other.inverted_corners;
+        self.nonpositive_decomposition += other.nonpositive_decomposition;
+        self.nodes_out_of_range += other.nodes_out_of_range;
+        let room = EXAMPLES.saturating_sub(self.examples.len());
+        self.examples.extend(other.examples.into_iter().take(room));
+    }
+}
+
 /// What can be wrong with a face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
