@@ -41,7 +41,9 @@ fn python() -> Option<String> {
             panic!("BLMESH_PYTHON is not set: CI must name a Python with gmsh, meshio and numpy")
         }
         _ => {
-            eprintln!("skipping the meshio/Gmsh checks: set BLMESH_PYTHON to a Python with gmsh, meshio, numpy");
+            eprintln!(
+                "skipping the meshio/Gmsh checks: set BLMESH_PYTHON to a Python with gmsh, meshio, numpy"
+            );
             None
         }
     }
@@ -100,8 +102,18 @@ fn hybrid_mesh_files_interoperate() {
 /// Files written by meshio and Gmsh from ours, read back by our readers.
 fn read_other_tools_files(python: &str, msh: &Path, vtu: &Path, dir: &Path, original: &CheckReport) {
     let out = dir.join("converted");
-    run(python, &["convert", &msh.display().to_string(), &vtu.display().to_string(), &out.display().to_string()]);
-    let names = ["meshio_zlib.vtu", "meshio_binary.vtu", "meshio_ascii.vtu", "meshio22.msh", "gmsh41_binary.msh", "gmsh22.msh"];
+    run(
+        python,
+        &["convert", &msh.display().to_string(), &vtu.display().to_string(), &out.display().to_string()],
+    );
+    let names = [
+        "meshio_zlib.vtu",
+        "meshio_binary.vtu",
+        "meshio_ascii.vtu",
+        "meshio22.msh",
+        "gmsh41_binary.msh",
+        "gmsh22.msh",
+    ];
     for name in names {
         let path = out.join(name);
         let mesh = read_volume_mesh(&path).unwrap_or_else(|e| panic!("{e}"));

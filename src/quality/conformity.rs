@@ -139,7 +139,8 @@ impl<'a, const N: usize> Owners<'a, N> {
 
     fn issue(&self, problem: FaceProblem, group: &[FaceUse<N>]) -> FaceIssue {
         let nodes = group.first().map(|u| self.oriented(u).to_vec()).unwrap_or_default();
-        let pts: Option<Vec<DVec3>> = nodes.iter().map(|&n| self.mesh.points.get(n as usize).copied()).collect();
+        let pts: Option<Vec<DVec3>> =
+            nodes.iter().map(|&n| self.mesh.points.get(n as usize).copied()).collect();
         let centre = pts.map(|p| (p.iter().sum::<DVec3>() / p.len().max(1) as f64).to_array());
         let (cells, bounds): (Vec<&FaceUse<N>>, Vec<_>) = group.iter().partition(|u| self.is_cell(u.owner));
         FaceIssue {
@@ -227,8 +228,13 @@ fn enclosed_part(points: &[DVec3], face: &[u32], origin: DVec3) -> f64 {
 
 /// Free quads whose two halves (along either diagonal) are unmatched free triangles: both
 /// the quad and the triangles are then reported as a non-matching quad split, not as holes.
-fn find_quad_splits(quads: &Owners<4>, quad_scan: &mut Scan<4>, tris: &Owners<3>, tri_scan: &mut Scan<3>,
-                    report: &mut Conformity) {
+fn find_quad_splits(
+    quads: &Owners<4>,
+    quad_scan: &mut Scan<4>,
+    tris: &Owners<3>,
+    tri_scan: &mut Scan<3>,
+    report: &mut Conformity,
+) {
     let unmatched = &mut tri_scan.unmatched;
     for quad in &quad_scan.free {
         let [a, b, c, d] = quads.oriented(quad);

@@ -161,7 +161,9 @@ mod tests {
             assert!((volume(kind, &x) - vol).abs() < 1e-14, "{kind:?} volume {}", volume(kind, &x));
             assert!((scaled_jacobian(kind, &x) - q).abs() < 1e-12, "{kind:?}");
             let mut smallest = f64::INFINITY;
-            for_each_subtet(kind, &x, |_, [a, b, c, d]| smallest = smallest.min(tet_signed_volume(a, b, c, d)));
+            for_each_subtet(kind, &x, |_, [a, b, c, d]| {
+                smallest = smallest.min(tet_signed_volume(a, b, c, d))
+            });
             assert!(smallest > 0.0, "{kind:?}");
         }
     }

@@ -29,13 +29,7 @@ pub fn check(mesh: &VolumeMesh) -> CheckReport {
     );
     let mut volume = 0.0;
     for (kind, block) in CellKind::ALL.into_iter().zip(blocks) {
-        let v = &mut report.validity;
-        v.invalid_cells += block.invalid;
-        v.inverted_corners += block.inverted_corners;
-        v.nonpositive_decomposition += block.nonpositive_subtets;
-        v.nodes_out_of_range += block.nodes_out_of_range;
-        let room = EXAMPLES.saturating_sub(v.examples.len());
-        v.examples.extend(block.examples.into_iter().take(room));
+        report.validity.append(block.validity);
         volume += block.volume;
         *report.quality.get_mut(kind) = block.quality;
     }
@@ -46,7 +40,8 @@ pub fn check(mesh: &VolumeMesh) -> CheckReport {
         ));
     }
     report.conformity = conformity;
-    report.volume = VolumeCheck { cells: volume, enclosed, relative_difference: relative_difference(volume, enclosed) };
+    report.volume =
+        VolumeCheck { cells: volume, enclosed, relative_difference: relative_difference(volume, enclosed) };
     report.unused_points = count_unused_points(mesh);
     if report.unused_points > 0 {
         report.warnings.push(format!("{} points are used by no cell", report.unused_points));
@@ -88,10 +83,13 @@ fn check_structure(mesh: &VolumeMesh, report: &mut CheckReport) {
         }
     }
     let b = &mesh.boundary;
-    report.patches = mesh.patch_names.iter().map(|name| PatchCount { name: name.clone(), ..Default::default() }).collect();
+    report.patches =
+        mesh.patch_names.iter().map(|name| PatchCount { name: name.clone(), ..Default::default() }).collect();
     let count = |what: &str, faces: usize, patches: &[u32], quads: bool, report: &mut CheckReport| {
         if faces != patches.len() {
-            report.structure_errors.push(format!("{faces} boundary {what} but {} patch indices", patches.len()));
+            report
+                .structure_errors
+                .push(format!("{faces} boundary {what} but {} patch indices", patches.len()));
         }
         let mut bad = 0;
         for &p in patches {
@@ -111,10 +109,13 @@ fn check_structure(mesh: &VolumeMesh, report: &mut CheckReport) {
     count("triangles", b.triangles.len(), &b.triangle_patch, false, report);
     count("quads", b.quads.len(), &b.quad_patch, true, report);
     let points = mesh.points.len();
-    let out_of_range = b.triangles.iter().flatten().chain(b.quads.iter().flatten()).filter(|&&n| n as usize >= points);
+    let out_of_range =
+        b.triangles.iter().flatten().chain(b.quads.iter().flatten()).filter(|&&n| n as usize >= points);
     let out_of_range = out_of_range.count();
     if out_of_range > 0 {
-        report.structure_errors.push(format!("{out_of_range} boundary face node indices >= {points} (the point count)"));
+        report
+            .structure_errors
+            .push(format!("{out_of_range} boundary face node indices >= {points} (the point count)"));
     }
 }
 

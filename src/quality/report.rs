@@ -88,6 +88,18 @@ pub struct Validity {
     pub examples: Vec<InvalidCell>,
 }
 
+impl Validity {
+    /// Add the counts of `other` and keep the first examples.
+    pub fn append(&mut self, other: Validity) {
+        self.invalid_cells += other.invalid_cells;
+        self.inverted_corners += other.inverted_corners;
+        self.nonpositive_decomposition += other.nonpositive_decomposition;
+        self.nodes_out_of_range += other.nodes_out_of_range;
+        let room = EXAMPLES.saturating_sub(self.examples.len());
+        self.examples.extend(other.examples.into_iter().take(room));
+    }
+}
+
 /// What can be wrong with a face.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Serialize)]
 #[serde(rename_all = "snake_case")]
@@ -182,7 +194,14 @@ pub struct QualityStats {
 
 impl Default for QualityStats {
     fn default() -> Self {
-        QualityStats { min: f64::INFINITY, max: f64::NEG_INFINITY, mean: 0.0, histogram: [0; 11], sum: 0.0, count: 0 }
+        QualityStats {
+            min: f64::INFINITY,
+            max: f64::NEG_INFINITY,
+            mean: 0.0,
+            histogram: [0; 11],
+            sum: 0.0,
+            count: 0,
+        }
     }
 }
 
@@ -239,8 +258,10 @@ impl KindQuality {
     pub fn merge(&mut self, other: &KindQuality) {
         self.cells += other.cells;
         self.scaled_jacobian.merge(&other.scaled_jacobian);
-        self.dihedral_deg =
-            [self.dihedral_deg[0].min(other.dihedral_deg[0]), self.dihedral_deg[1].max(other.dihedral_deg[1])];
+        self.dihedral_deg = [
+            self.dihedral_deg[0].min(other.dihedral_deg[0]),
+            self.dihedral_deg[1].max(other.dihedral_deg[1]),
+        ];
     }
 }
 
@@ -309,7 +330,8 @@ impl fmt::Display for CheckReport {
         let verdict = if self.volume_identity_holds() { "ok" } else { "MISMATCH" };
         writeln!(
             f,
-            "volume: cells {:.12e}, enclosed by the free faces {:.12e}, relative difference {:.1e} ({verdict})",
+            "volume: cells {:.12e}, enclosed by the free faces {:.12e}, relative difference {:.1e} \
+             ({verdict})",
             v.cells, v.enclosed, v.relative_difference
         )?;
         write_quality(&self.quality, f)?;
@@ -318,8 +340,16 @@ impl fmt::Display for CheckReport {
 }
 
 fn write_counts(r: &CheckReport, f: &mut fmt::Formatter<'_>) -> fmt::Result {
-    let kinds: Vec<String> = CellKind::ALL.iter().map(|&k| format!("{} {}", r.cells.get(k), k.name())).collect();
-    writeln!(f, "points: {} ({} unused); cells: {} ({})", r.points, r.unused_points, r.cell_count(), kinds.join(", "))?;
+    let kinds: Vec<String> =
+        CellKind::ALL.iter().map(|&k| format!("{} {}", r.cells.get(k), k.name())).collect();
+    writeln!(
+        f,
+        "points: {} ({} unused); cells: {} ({})",
+        r.points,
+        r.unused_points,
+        r.cell_count(),
+        kinds.join(", ")
+    )?;
     let patches: Vec<String> =
         r.patches.iter().map(|p| format!("{} ({} tri, {} quad)", p.name, p.triangles, p.quads)).collect();
     writeln!(f, "patches: {}", if patches.is_empty() { "none".to_string() } else { patches.join(", ") })
@@ -337,7 +367,15 @@ fn write_validity(v: &Validity, f: &mut fmt::Formatter<'_>) -> fmt::Result {
     )?;
     for e in &v.examples {
         let pts: Vec<String> = e.points.iter().take(4).map(point).collect();
-        writeln!(f, "  {} {} nodes {:?}: {} at {}", e.cell.kind.name(), e.cell.index, e.nodes, e.problem, pts.join(" "))?;
+        writeln!(
+            f,
+            "  {} {} nodes {:?}: {} at {}",
+            e.cell.kind.name(),
+            e.cell.index,
+            e.nodes,
+            e.problem,
+            pts.join(" ")
+        )?;
     }
     Ok(())
 }

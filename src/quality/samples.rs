@@ -23,7 +23,8 @@ pub enum CubeSplit {
 }
 
 impl CubeSplit {
-    pub const ALL: [CubeSplit; 4] = [CubeSplit::Hexahedron, CubeSplit::Tetrahedra, CubeSplit::Prisms, CubeSplit::Centre];
+    pub const ALL: [CubeSplit; 4] =
+        [CubeSplit::Hexahedron, CubeSplit::Tetrahedra, CubeSplit::Prisms, CubeSplit::Centre];
 
     fn wants_quad(self, axis: usize) -> bool {
         match self {
@@ -57,7 +58,16 @@ impl Grid<'_> {
     /// Hexahedron nodes of cube `c`.
     fn cube_nodes(&self, [i, j, k]: [usize; 3]) -> [u32; 8] {
         let corner = |a, b, c| self.point_index([i + a, j + b, k + c]);
-        [corner(0, 0, 0), corner(1, 0, 0), corner(1, 1, 0), corner(0, 1, 0), corner(0, 0, 1), corner(1, 0, 1), corner(1, 1, 1), corner(0, 1, 1)]
+        [
+            corner(0, 0, 0),
+            corner(1, 0, 0),
+            corner(1, 1, 0),
+            corner(0, 1, 0),
+            corner(0, 0, 1),
+            corner(1, 0, 1),
+            corner(1, 1, 1),
+            corner(0, 1, 1),
+        ]
     }
 
     /// The cube across face (axis, side), if inside the grid.
@@ -69,7 +79,8 @@ impl Grid<'_> {
 
     fn face_is_quad(&self, c: [usize; 3], face: (usize, usize)) -> bool {
         let axis = face.0;
-        (self.split)(c).wants_quad(axis) && self.neighbour(c, face).is_none_or(|n| (self.split)(n).wants_quad(axis))
+        (self.split)(c).wants_quad(axis)
+            && self.neighbour(c, face).is_none_or(|n| (self.split)(n).wants_quad(axis))
     }
 
     /// The cut actually used for cube `c`: the one asked for if its faces fit, else `Centre`.

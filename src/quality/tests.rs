@@ -117,7 +117,8 @@ fn a_doubled_element_is_found() {
 /// y = 0 quad that cut it into two triangles.
 fn prism_next_to_two_tets() -> VolumeMesh {
     let mut mesh = VolumeMesh::default();
-    let p = [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.], [1., 0., 1.], [0., 1., 1.], [0.5, -1., 0.5]];
+    let p =
+        [[0., 0., 0.], [1., 0., 0.], [0., 1., 0.], [0., 0., 1.], [1., 0., 1.], [0., 1., 1.], [0.5, -1., 0.5]];
     mesh.points = p.iter().map(|q| DVec3::from_array(*q)).collect();
     mesh.push_cell(CellKind::Prism, &[0, 1, 2, 3, 4, 5], 0);
     mesh.push_cell(CellKind::Tetrahedron, &[0, 1, 4, 6], 0);

@@ -7,8 +7,10 @@
 
 use rayon::prelude::*;
 
-use super::measures::{dihedral_range, edge_face_pairs, for_each_subtet, scaled_jacobian, volume, CellPoints};
-use super::report::{CellRef, InvalidCell, KindQuality, EXAMPLES};
+use super::measures::{
+    dihedral_range, edge_face_pairs, for_each_subtet, scaled_jacobian, volume, CellPoints,
+};
+use super::report::{CellRef, InvalidCell, KindQuality, Validity, EXAMPLES};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -58,11 +60,7 @@ pub fn gather(points: &[DVec3], nodes: &[u32]) -> Option<CellPoints> {
 /// What the pass over one block found.
 #[derive(Clone, Debug, Default)]
 pub struct BlockResult {
-    pub invalid: usize,
-    pub inverted_corners: usize,
-    pub nonpositive_subtets: usize,
-    pub nodes_out_of_range: usize,
-    pub examples: Vec<InvalidCell>,
+    pub validity: Validity,
     pub volume: f64,
     pub quality: KindQuality,
 }
@@ -70,12 +68,7 @@ pub struct BlockResult {
 impl BlockResult {
     /// Append the result of the cells that follow (keeps the first examples).
     fn append(&mut self, other: BlockResult) {
-        self.invalid += other.invalid;
-        self.inverted_corners += other.inverted_corners;
-        self.nonpositive_subtets += other.nonpositive_subtets;
-        self.nodes_out_of_range += other.nodes_out_of_range;
-        let room = EXAMPLES.saturating_sub(self.examples.len());
-        self.examples.extend(other.examples.into_iter().take(room));
+        self.validity.append(other.validity);
         self.volume += other.volume;
         self.quality.merge(&other.quality);
     }
@@ -107,24 +100,32 @@ pub fn check_block(mesh: &VolumeMesh, kind: CellKind) -> BlockResult {
     result
 }
 
-fn check_cell(mesh: &VolumeMesh, cell: CellRef, nodes: &[u32], pairs: &[(usize, usize)], out: &mut BlockResult) {
+fn check_cell(
+    mesh: &VolumeMesh,
+    cell: CellRef,
+    nodes: &[u32],
+    pairs: &[(usize, usize)],
+    out: &mut BlockResult,
+) {
     let kind = cell.kind;
     let Some(x) = gather(&mesh.points, nodes) else {
-        out.invalid += 1;
-        out.nodes_out_of_range += 1;
-        if out.examples.len() < EXAMPLES {
-            out.examples.push(InvalidCell::new(cell, nodes, &[], "node index out of range".into()));
+        let v = &mut out.validity;
+        v.invalid_cells += 1;
+        v.nodes_out_of_range += 1;
+        if v.examples.len() < EXAMPLES {
+            v.examples.push(InvalidCell::new(cell, nodes, &[], "node index out of range".into()));
         }
         return;
     };
     let validity = cell_validity(kind, &x);
     if !validity.is_valid() {
-        out.invalid += 1;
-        out.inverted_corners += usize::from(validity.bad_corner.is_some());
-        out.nonpositive_subtets += usize::from(validity.bad_subtet.is_some());
-        if out.examples.len() < EXAMPLES {
+        let v = &mut out.validity;
+        v.invalid_cells += 1;
+        v.inverted_corners += usize::from(validity.bad_corner.is_some());
+        v.nonpositive_decomposition += usize::from(validity.bad_subtet.is_some());
+        if v.examples.len() < EXAMPLES {
             let problem = describe(kind, &validity);
-            out.examples.push(InvalidCell::new(cell, nodes, &x[..kind.node_count()], problem));
+            v.examples.push(InvalidCell::new(cell, nodes, &x[..kind.node_count()], problem));
         }
     }
     out.volume += volume(kind, &x);

@@ -12,10 +12,10 @@ use std::collections::{HashMap, HashSet};
 
 pub use write::write;
 
-use read::{RawBlock, RawMesh, Shape};
 use super::ParseError;
 use crate::mesh::VolumeMesh;
 use crate::surface::Surface;
+use read::{RawBlock, RawMesh, Shape};
 
 /// Names of the groups (patches or zones) of one dimension, and the group of every block.
 struct Groups {
@@ -25,18 +25,17 @@ struct Groups {
 
 impl Groups {
     fn new(raw: &RawMesh, dim: i32, prefix: &str) -> Groups {
-        let labels: Vec<Option<(String, (u8, i32))>> = raw
-            .blocks
-            .iter()
-            .map(|b| (b.shape.dim() == dim).then(|| label(raw, dim, b, prefix)))
-            .collect();
+        let labels: Vec<Option<(String, (u8, i32))>> =
+            raw.blocks.iter().map(|b| (b.shape.dim() == dim).then(|| label(raw, dim, b, prefix))).collect();
         let mut distinct: Vec<&(String, (u8, i32))> = labels.iter().flatten().collect();
         distinct.sort_by(|a, b| (a.1, &a.0).cmp(&(b.1, &b.0)));
         let mut seen = HashSet::new();
         distinct.retain(|l| seen.insert(l.0.as_str()));
         let names: Vec<String> = distinct.iter().map(|l| l.0.clone()).collect();
-        let index: HashMap<&str, u32> = names.iter().enumerate().map(|(i, n)| (n.as_str(), i as u32)).collect();
-        let of_block = labels.iter().map(|l| l.as_ref().and_then(|l| index.get(l.0.as_str()).copied()).unwrap_or(0));
+        let index: HashMap<&str, u32> =
+            names.iter().enumerate().map(|(i, n)| (n.as_str(), i as u32)).collect();
+        let of_block =
+            labels.iter().map(|l| l.as_ref().and_then(|l| index.get(l.0.as_str()).copied()).unwrap_or(0));
         Groups { of_block: of_block.collect(), names }
     }
 }
@@ -87,7 +86,9 @@ pub fn parse_volume(bytes: &[u8]) -> Result<VolumeMesh, ParseError> {
         }
     }
     if mesh.cell_count() == 0 {
-        return Err(ParseError::file("no volume elements (tetrahedra, pyramids, prisms, hexahedra) in the file"));
+        return Err(ParseError::file(
+            "no volume elements (tetrahedra, pyramids, prisms, hexahedra) in the file",
+        ));
     }
     mesh.points = raw.points;
     mesh.patch_names = patches.names;
@@ -112,7 +113,9 @@ pub fn parse_surface(bytes: &[u8]) -> Result<Surface, ParseError> {
     for (i, block) in raw.blocks.iter().enumerate() {
         let faces: Vec<[u32; 3]> = match block.shape {
             Shape::Triangle => block.nodes.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
-            Shape::Quad => block.nodes.chunks_exact(4).flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect(),
+            Shape::Quad => {
+                block.nodes.chunks_exact(4).flat_map(|q| [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]).collect()
+            }
             Shape::Cell(_) => continue,
         };
         for f in faces {

@@ -48,7 +48,7 @@ fn element_type(t: i32) -> Option<ElementType> {
     Some(match t {
         2 => Keep(Shape::Triangle),
         3 => Keep(Shape::Quad),
-        4 | 5 | 6 | 7 => Keep(Shape::Cell(CellKind::from_gmsh_type(t)?)),
+        4..=7 => Keep(Shape::Cell(CellKind::from_gmsh_type(t)?)),
         1 => Skip(2),
         8 => Skip(3),
         15 => Skip(1),
@@ -117,22 +117,17 @@ pub fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
         let Some(v) = version else {
             return Err(c.error(format!("${} before $MeshFormat: not an MSH file", clip(name))));
         };
-        if name == "PhysicalNames" {
-            read_physical_names(&mut c, &mut mesh)?;
-            c.expect("$EndPhysicalNames")?;
-            continue;
-        }
-        let known = matches!(name, "Entities" | "Nodes" | "Elements") && !(v == Version::V2 && name == "Entities");
-        if !known {
-            c.skip_past(&format!("$End{name}"))?;
-            continue;
-        }
         match (name, v) {
-            ("Entities", _) => with_binary(&mut c, binary, |c| read_entities(c, &mut mesh))?,
+            ("PhysicalNames", _) => read_physical_names(&mut c, &mut mesh)?,
+            ("Entities", Version::V4) => with_binary(&mut c, binary, |c| read_entities(c, &mut mesh))?,
             ("Nodes", Version::V4) => with_binary(&mut c, binary, |c| read_nodes4(c, &mut mesh))?,
             ("Elements", Version::V4) => with_binary(&mut c, binary, |c| read_elements4(c, &mut mesh))?,
-            ("Nodes", _) => read_nodes2(&mut c, binary, &mut mesh)?,
-            _ => read_elements2(&mut c, binary, &mut mesh)?,
+            ("Nodes", Version::V2) => read_nodes2(&mut c, binary, &mut mesh)?,
+            ("Elements", Version::V2) => read_elements2(&mut c, binary, &mut mesh)?,
+            _ => {
+                c.skip_past(&format!("$End{name}"))?;
+                continue;
+            }
         }
         c.expect(&format!("$End{name}"))?;
     }
@@ -329,12 +324,15 @@ fn read_elements4(c: &mut Cursor, mesh: &mut RawMesh) -> Result<(), ParseError> 
             }
             Some(ElementType::HigherOrder(s)) => return Err(higher_order_error(c, t, s)),
             None if !c.binary => {
+                c.rest_of_line(); // the block header's line break, then one line per element
                 for _ in 0..n {
                     c.rest_of_line();
                 }
                 continue;
             }
-            None => return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file"))),
+            None => {
+                return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file")))
+            }
         };
         let nodes_per = shape.node_count();
         let block = block_for(&mut mesh.blocks, shape, entity, None);
@@ -379,7 +377,9 @@ fn read_elements2(c: &mut Cursor, binary: bool, mesh: &mut RawMesh) -> Result<()
             Some(ElementType::Keep(shape)) => shape.node_count(),
             Some(ElementType::Skip(nodes)) => nodes,
             Some(ElementType::HigherOrder(s)) => return Err(higher_order_error(c, t, s)),
-            None => return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file"))),
+            None => {
+                return Err(c.error(format!("unknown element type {t}: its size is unknown in a binary file")))
+            }
         };
         if follow == 0 || follow > n - read {
             return Err(c.error(format!("element header announces {follow} elements, {} remain", n - read)));

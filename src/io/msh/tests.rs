@@ -124,6 +124,19 @@ fn gmsh_41_ascii_with_sparse_tags_and_groups() {
 }
 
 #[test]
+fn unknown_element_types_are_skipped_in_text() {
+    let unknown = "0 1 15 1\n100 5\n0 1 99 2\n200 1 2 3 4 5 6 7\n201 1 2 3 4 5 6 7\n";
+    let mesh = parse_volume(
+        GMSH41.replace("6 7 100 106", "7 9 100 201").replace("0 1 15 1\n100 5\n", unknown).as_bytes(),
+    );
+    assert!(check(&mesh.unwrap()).is_valid());
+    let mesh = parse_volume(
+        GMSH22.replace("7\n1 15 2 0 1 10", "8\n0 99 2 0 1 1 2 3 4 5 6 7\n1 15 2 0 1 10").as_bytes(),
+    );
+    assert!(check(&mesh.unwrap()).is_valid());
+}
+
+#[test]
 fn gmsh_22_ascii() {
     let mesh = parse_volume(GMSH22.as_bytes()).unwrap();
     assert_eq!(mesh.patch_names, ["wall left", "physical_8", "surface_4"]);
@@ -178,7 +191,9 @@ fn unit_tet_41(big_endian: bool) -> Vec<u8> {
 fn unit_tet_22(big_endian: bool) -> Vec<u8> {
     use V::*;
     let mut parts = vec![T("$MeshFormat\n2.2 1 8\n"), I(1), T("\n$EndMeshFormat\n$Nodes\n4\n")];
-    for (tag, x) in [(10, [0.0, 0.0, 0.0]), (20, [1.0, 0.0, 0.0]), (30, [0.0, 1.0, 0.0]), (40, [0.0, 0.0, 1.0])] {
+    for (tag, x) in
+        [(10, [0.0, 0.0, 0.0]), (20, [1.0, 0.0, 0.0]), (30, [0.0, 1.0, 0.0]), (40, [0.0, 0.0, 1.0])]
+    {
         parts.extend([I(tag), D(x[0]), D(x[1]), D(x[2])]);
     }
     parts.extend([T("\n$EndNodes\n$Elements\n1\n"), I(4), I(1), I(2), I(5), I(0), I(3)]);
@@ -231,7 +246,9 @@ fn truncated_binary_files_fail_at_a_byte_offset() {
         // A cut between two sections leaves a whole file without cells (a file-level error).
         match parse_volume(&bytes[..cut]) {
             Err(ParseError { at: Location::Byte(b), .. }) => assert!(b as usize <= cut),
-            Err(ParseError { at: Location::File, message }) => assert!(message.contains("no volume elements")),
+            Err(ParseError { at: Location::File, message }) => {
+                assert!(message.contains("no volume elements"))
+            }
             other => panic!("cut at {cut}: {other:?}"),
         }
     }
@@ -239,8 +256,12 @@ fn truncated_binary_files_fail_at_a_byte_offset() {
 
 proptest::proptest! {
     #[test]
-    fn arbitrary_damage_never_panics(cut in 0usize..4000, flips in proptest::collection::vec((0usize..4000, 0u8..=255), 0..4)) {
-        for mut bytes in [GMSH41.as_bytes().to_vec(), write_to_vec(&hybrid_column(), false), unit_tet_22(true)] {
+    fn arbitrary_damage_never_panics(
+        cut in 0usize..4000,
+        flips in proptest::collection::vec((0usize..4000, 0u8..=255), 0..4),
+    ) {
+        let files = [GMSH41.as_bytes().to_vec(), write_to_vec(&hybrid_column(), false), unit_tet_22(true)];
+        for mut bytes in files {
             for &(at, b) in &flips {
                 let n = bytes.len();
                 bytes[at % n] = b;

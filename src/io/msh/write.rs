@@ -83,10 +83,10 @@ fn max_index(indices: impl Iterator<Item = u32>) -> usize {
 /// Write `mesh` as MSH 4.1 (binary unless `ascii`).
 pub fn write(w: &mut dyn Write, mesh: &VolumeMesh, ascii: bool) -> io::Result<()> {
     let b = &mesh.boundary;
-    let patch_count = max_index(b.triangle_patch.iter().chain(&b.quad_patch).copied()).max(mesh.patch_names.len());
-    let zone_count = max_index(mesh.blocks.iter().flat_map(|b| b.zone.iter().copied()))
-        .max(mesh.zone_names.len())
-        .max(1);
+    let patch_count =
+        max_index(b.triangle_patch.iter().chain(&b.quad_patch).copied()).max(mesh.patch_names.len());
+    let zone_count =
+        max_index(mesh.blocks.iter().flat_map(|b| b.zone.iter().copied())).max(mesh.zone_names.len()).max(1);
     let patches = group_names(&mesh.patch_names, patch_count, "patch");
     let zones = group_names(&mesh.zone_names, zone_count, "zone");
     let mut out = Out { w, ascii, first_on_line: true };
@@ -109,7 +109,9 @@ pub fn write(w: &mut dyn Write, mesh: &VolumeMesh, ascii: bool) -> io::Result<()
 }
 
 fn write_entities(out: &mut Out, mesh: &VolumeMesh, patches: usize, zones: usize) -> io::Result<()> {
-    let bbox = if mesh.points.is_empty() { Aabb { min: Default::default(), max: Default::default() } } else {
+    let bbox = if mesh.points.is_empty() {
+        Aabb { min: Default::default(), max: Default::default() }
+    } else {
         Aabb::from_points(&mesh.points)
     };
     out.begin("Entities")?;
@@ -189,7 +191,8 @@ fn element_blocks(mesh: &VolumeMesh, patches: usize, zones: usize) -> Vec<Block<
     for kind in CellKind::ALL {
         let block = mesh.block(kind);
         let (gmsh_type, nodes_per) = (kind.gmsh_type(), kind.node_count());
-        for (z, cells) in bucket(block.iter().zip(block.zone.iter().copied()), zones).into_iter().enumerate() {
+        for (z, cells) in bucket(block.iter().zip(block.zone.iter().copied()), zones).into_iter().enumerate()
+        {
             blocks.push(Block { dim: 3, entity: z + 1, gmsh_type, nodes_per, elements: cells });
         }
     }

@@ -118,7 +118,11 @@ pub fn floats(bytes: &[u8], ty: Scalar, swap: bool) -> Vec<f64> {
 pub fn ascii<T: std::str::FromStr>(text: &[u8]) -> Result<Vec<T>, String> {
     let text = std::str::from_utf8(text).map_err(|_| "non-text bytes in an ASCII array".to_string())?;
     text.split_ascii_whitespace()
-        .map(|t| t.parse().map_err(|_| format!("'{}' is not a number of the array's type", t.chars().take(30).collect::<String>())))
+        .map(|t| {
+            t.parse().map_err(|_| {
+                format!("'{}' is not a number of the array's type", t.chars().take(30).collect::<String>())
+            })
+        })
         .collect()
 }
 
@@ -156,7 +160,9 @@ pub fn block(bytes: &[u8], layout: Layout) -> Result<(Vec<u8>, usize), String> {
     let hs = layout.header.size();
     if !layout.compressed {
         let n = header_value(bytes, 0, layout)?;
-        let data = bytes.get(hs..hs.saturating_add(n)).ok_or_else(|| format!("data block truncated: {n} bytes announced"))?;
+        let data = bytes
+            .get(hs..hs.saturating_add(n))
+            .ok_or_else(|| format!("data block truncated: {n} bytes announced"))?;
         return Ok((data.to_vec(), hs + n));
     }
     let blocks = header_value(bytes, 0, layout)?;
@@ -226,7 +232,10 @@ mod tests {
     #[test]
     fn values_of_every_type() {
         assert_eq!(ints(&(-3i16).to_be_bytes(), Scalar::I16, true).unwrap(), [-3]);
-        assert_eq!(ints(&u64::MAX.to_le_bytes(), Scalar::U64, false).unwrap_err(), "integer value out of range");
+        assert_eq!(
+            ints(&u64::MAX.to_le_bytes(), Scalar::U64, false).unwrap_err(),
+            "integer value out of range"
+        );
         assert_eq!(floats(&1.5f32.to_le_bytes(), Scalar::F32, false), [1.5]);
         assert_eq!(ascii::<i64>(b" 1\n 2 ").unwrap(), [1, 2]);
         assert!(ascii::<i64>(b"1 x").is_err());

@@ -13,10 +13,10 @@ mod write;
 
 pub use write::write;
 
-use read::{Array, Section, VtuFile};
 use super::ParseError;
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
+use read::{Array, Section, VtuFile};
 
 /// CellData arrays that can hold the boundary patch of a face, by priority.
 pub const PATCH_ARRAYS: [&str; 5] = ["patch", "gmsh:physical", "cell_tags", "CellEntityIds", "medit:ref"];
@@ -50,11 +50,14 @@ struct Groups {
 }
 
 impl Groups {
-    fn new(values: impl Iterator<Item = i64>, prefix: &str, default: &str, has_array: bool) -> Groups {
-        let mut v: Vec<i64> = values.collect();
+    fn new(mut v: Vec<i64>, prefix: &str, default: &str, has_array: bool) -> Groups {
         v.sort_unstable();
         v.dedup();
-        let names = if has_array { v.iter().map(|x| format!("{prefix}_{x}")).collect() } else { vec![default.into()] };
+        let names = if has_array {
+            v.iter().map(|x| format!("{prefix}_{x}")).collect()
+        } else {
+            vec![default.into()]
+        };
         Groups { values: v, names }
     }
 
@@ -63,7 +66,12 @@ impl Groups {
     }
 }
 
-fn required<'f, 'a>(file: &'f VtuFile<'a>, section: Section, name: Option<&str>, what: &str) -> Result<&'f Array<'a>, ParseError> {
+fn required<'f, 'a>(
+    file: &'f VtuFile<'a>,
+    section: Section,
+    name: Option<&str>,
+    what: &str,
+) -> Result<&'f Array<'a>, ParseError> {
     file.find(section, name).ok_or_else(|| ParseError::file(format!("no {what} DataArray")))
 }
 
@@ -97,6 +105,98 @@ fn tag_array(file: &VtuFile, names: &[&str]) -> Result<Option<Vec<i64>>, ParseEr
     found.map(|a| per_cell(file, a)).transpose()
 }
 
+/// The cells of the file: VTK types, and the node lists as connectivity + end offsets.
+struct Cells<'f, 'a> {
+    connectivity: Vec<i64>,
+    offsets: Vec<i64>,
+    types: Vec<i64>,
+    /// The connectivity array, where cell errors are reported.
+    array: &'f Array<'a>,
+}
+
+impl<'f, 'a> Cells<'f, 'a> {
+    fn read(file: &'f VtuFile<'a>) -> Result<Self, ParseError> {
+        let array = required(file, Section::Cells, Some("connectivity"), "connectivity")?;
+        Ok(Cells {
+            connectivity: file.ints(array)?,
+            offsets: per_cell(file, required(file, Section::Cells, Some("offsets"), "offsets")?)?,
+            types: per_cell(file, required(file, Section::Cells, Some("types"), "types")?)?,
+            array,
+        })
+    }
+
+    /// What cell `i` becomes and its nodes in our order (`None`: a cell to skip).
+    fn cell(
+        &self,
+        file: &VtuFile,
+        i: usize,
+        points: usize,
+    ) -> Result<Option<(VtkCell, Vec<u32>)>, ParseError> {
+        let error = |m: String| file.error(self.array, format!("cell {i}: {m}"));
+        let start = if i == 0 { Some(0) } else { usize::try_from(self.offsets[i - 1]).ok() };
+        let end = usize::try_from(self.offsets[i]).ok();
+        let nodes = match (start, end) {
+            (Some(s), Some(e)) if s <= e && e <= self.connectivity.len() => &self.connectivity[s..e],
+            _ => return Err(error(format!("offset {} out of range", self.offsets[i]))),
+        };
+        let t = self.types[i];
+        let shape = vtk_cell(t).ok_or_else(|| error(format!("unsupported VTK cell type {t}")))?;
+        let (count, perm) = match shape {
+            VtkCell::Skip => return Ok(None),
+            VtkCell::Face(n, perm) => (n, perm),
+            VtkCell::Volume(kind, perm) => (kind.node_count(), perm),
+        };
+        if nodes.len() != count {
+            return Err(error(format!("{} nodes for VTK type {t} ({count} expected)", nodes.len())));
+        }
+        let ours = perm.iter().map(|&p| {
+            let n = nodes[p];
+            u32::try_from(n)
+                .ok()
+                .filter(|&n| (n as usize) < points)
+                .ok_or_else(|| error(format!("node {n} out of range ({points} points)")))
+        });
+        Ok(Some((shape, ours.collect::<Result<_, _>>()?)))
+    }
+}
+
+/// The patch of every face and the zone of every volume cell, from the CellData arrays.
+struct Tags {
+    patch: Option<Vec<i64>>,
+    zone: Option<Vec<i64>>,
+    patches: Groups,
+    zones: Groups,
+}
+
+impl Tags {
+    fn read(file: &VtuFile, types: &[i64]) -> Result<Tags, ParseError> {
+        let patch = tag_array(file, &PATCH_ARRAYS)?;
+        let zone = match tag_array(file, &["zone"])? {
+            Some(z) => Some(z),
+            None => patch.clone(),
+        };
+        let values_of = |values: &Option<Vec<i64>>, face: bool| {
+            let kept = |i: &usize| match vtk_cell(types[*i]) {
+                Some(VtkCell::Face(..)) => face,
+                Some(VtkCell::Volume(..)) => !face,
+                _ => false,
+            };
+            (0..types.len()).filter(kept).map(|i| values.as_ref().map_or(0, |v| v[i])).collect()
+        };
+        let patches = Groups::new(values_of(&patch, true), "patch", "boundary", patch.is_some());
+        let zones = Groups::new(values_of(&zone, false), "zone", "volume", zone.is_some());
+        Ok(Tags { patch, zone, patches, zones })
+    }
+
+    fn patch(&self, i: usize) -> u32 {
+        self.patches.index(self.patch.as_ref().map_or(0, |v| v[i]))
+    }
+
+    fn zone(&self, i: usize) -> u32 {
+        self.zones.index(self.zone.as_ref().map_or(0, |v| v[i]))
+    }
+}
+
 /// Read a `.vtu` volume mesh; 2D cells become boundary faces.
 pub fn parse(bytes: &[u8]) -> Result<VolumeMesh, ParseError> {
     let file = read::scan(bytes)?;
@@ -104,61 +204,32 @@ pub fn parse(bytes: &[u8]) -> Result<VolumeMesh, ParseError> {
     if file.cells == 0 {
         return Err(ParseError::file("the file has no cells"));
     }
-    let connectivity_array = required(&file, Section::Cells, Some("connectivity"), "connectivity")?;
-    let connectivity = file.ints(connectivity_array)?;
-    let offsets = per_cell(&file, required(&file, Section::Cells, Some("offsets"), "offsets")?)?;
-    let types = per_cell(&file, required(&file, Section::Cells, Some("types"), "types")?)?;
-    let patch = tag_array(&file, &PATCH_ARRAYS)?;
-    let zone = match tag_array(&file, &["zone"])? {
-        Some(z) => Some(z),
-        None => patch.clone(),
-    };
-    let tag = |values: &Option<Vec<i64>>, i: usize| values.as_ref().map_or(0, |v| v[i]);
-    let face_kind = |t: i64| matches!(vtk_cell(t), Some(VtkCell::Face(..)));
-    let volume_kind = |t: i64| matches!(vtk_cell(t), Some(VtkCell::Volume(..)));
-    let patches = Groups::new((0..file.cells).filter(|&i| face_kind(types[i])).map(|i| tag(&patch, i)), "patch", "boundary", patch.is_some());
-    let zones = Groups::new((0..file.cells).filter(|&i| volume_kind(types[i])).map(|i| tag(&zone, i)), "zone", "volume", zone.is_some());
-    let cell_error = |i: usize, m: String| file.error(connectivity_array, format!("cell {i}: {m}"));
-    let mut start = 0usize;
+    let cells = Cells::read(&file)?;
+    let tags = Tags::read(&file, &cells.types)?;
     for i in 0..file.cells {
-        let end = usize::try_from(offsets[i]).ok().filter(|&e| e >= start && e <= connectivity.len());
-        let Some(end) = end else {
-            return Err(cell_error(i, format!("offset {} out of range", offsets[i])));
-        };
-        let nodes = &connectivity[start..end];
-        start = end;
-        let mut ours = [0u32; 8];
-        let shape = vtk_cell(types[i]).ok_or_else(|| cell_error(i, format!("unsupported VTK cell type {}", types[i])))?;
-        let (count, perm) = match shape {
-            VtkCell::Skip => continue,
-            VtkCell::Face(n, perm) => (n, perm),
-            VtkCell::Volume(kind, perm) => (kind.node_count(), perm),
-        };
-        if nodes.len() != count {
-            return Err(cell_error(i, format!("{} nodes for VTK type {} ({count} expected)", nodes.len(), types[i])));
-        }
-        for (o, &p) in ours.iter_mut().zip(perm) {
-            let n = nodes[p];
-            *o = u32::try_from(n).ok().filter(|&n| (n as usize) < mesh.points.len())
-                .ok_or_else(|| cell_error(i, format!("node {n} out of range ({} points)", mesh.points.len())))?;
-        }
-        match shape {
-            VtkCell::Volume(kind, _) => mesh.push_cell(kind, &ours[..count], zones.index(tag(&zone, i))),
-            _ if count == 3 => {
-                mesh.boundary.triangles.push([ours[0], ours[1], ours[2]]);
-                mesh.boundary.triangle_patch.push(patches.index(tag(&patch, i)));
+        let Some((shape, nodes)) = cells.cell(&file, i, mesh.points.len())? else { continue };
+        let faces = &mut mesh.boundary;
+        match (shape, nodes.as_slice()) {
+            (VtkCell::Volume(kind, _), _) => mesh.push_cell(kind, &nodes, tags.zone(i)),
+            (_, &[a, b, c]) => {
+                faces.triangles.push([a, b, c]);
+                faces.triangle_patch.push(tags.patch(i));
             }
-            _ => {
-                mesh.boundary.quads.push([ours[0], ours[1], ours[2], ours[3]]);
-                mesh.boundary.quad_patch.push(patches.index(tag(&patch, i)));
+            (_, &[a, b, c, d]) => {
+                faces.quads.push([a, b, c, d]);
+                faces.quad_patch.push(tags.patch(i));
             }
+            _ => {}
         }
     }
     if mesh.cell_count() == 0 {
-        return Err(ParseError::file("no volume cells (tetrahedra, pyramids, wedges, hexahedra) in the file"));
+        return Err(ParseError::file(
+            "no volume cells (tetrahedra, pyramids, wedges, hexahedra) in the file",
+        ));
     }
-    mesh.patch_names = if mesh.boundary.triangles.is_empty() && mesh.boundary.quads.is_empty() { Vec::new() } else { patches.names };
-    mesh.zone_names = zones.names;
+    let has_faces = !mesh.boundary.triangles.is_empty() || !mesh.boundary.quads.is_empty();
+    mesh.patch_names = if has_faces { tags.patches.names } else { Vec::new() };
+    mesh.zone_names = tags.zones.names;
     Ok(mesh)
 }
 

@@ -112,7 +112,9 @@ pub fn scan(bytes: &[u8]) -> Result<VtuFile<'_>, ParseError> {
     let mut pieces = 0;
     loop {
         let at = reader.buffer_position() as usize;
-        let event = reader.read_event().map_err(|e| error_at(bytes, reader.error_position() as usize, format!("bad XML: {e}")))?;
+        let event = reader
+            .read_event()
+            .map_err(|e| error_at(bytes, reader.error_position() as usize, format!("bad XML: {e}")))?;
         match event {
             Event::Empty(e) if e.local_name().as_ref() == b"DataArray" => {
                 file.arrays.push(data_array(bytes, &e, at, section)?);
@@ -125,27 +127,29 @@ pub fn scan(bytes: &[u8]) -> Result<VtuFile<'_>, ParseError> {
                 array.text = xml.get(span.start as usize..span.end as usize).unwrap_or_default();
                 file.arrays.push(array);
             }
-            Event::Start(e) | Event::Empty(e) => {
-                match e.local_name().as_ref() {
-                    b"VTKFile" => {
-                        seen_root = true;
-                        read_root(bytes, &e, at, &mut file)?;
-                    }
-                    b"Piece" => {
-                        pieces += 1;
-                        if pieces > 1 {
-                            return Err(error_at(bytes, at, "several <Piece>s: only single-piece files are read"));
-                        }
-                        file.points = count_attribute(bytes, &e, at, "NumberOfPoints")?;
-                        file.cells = count_attribute(bytes, &e, at, "NumberOfCells")?;
-                    }
-                    b"Points" => section = Section::Points,
-                    b"Cells" => section = Section::Cells,
-                    b"CellData" => section = Section::CellData,
-                    b"PointData" | b"FieldData" => section = Section::Other,
-                    _ => {}
+            Event::Start(e) | Event::Empty(e) => match e.local_name().as_ref() {
+                b"VTKFile" => {
+                    seen_root = true;
+                    read_root(bytes, &e, at, &mut file)?;
                 }
-            }
+                b"Piece" => {
+                    pieces += 1;
+                    if pieces > 1 {
+                        return Err(error_at(
+                            bytes,
+                            at,
+                            "several <Piece>s: only single-piece files are read",
+                        ));
+                    }
+                    file.points = count_attribute(bytes, &e, at, "NumberOfPoints")?;
+                    file.cells = count_attribute(bytes, &e, at, "NumberOfCells")?;
+                }
+                b"Points" => section = Section::Points,
+                b"Cells" => section = Section::Cells,
+                b"CellData" => section = Section::CellData,
+                b"PointData" | b"FieldData" => section = Section::Other,
+                _ => {}
+            },
             Event::End(e) if matches!(e.local_name().as_ref(), b"Points" | b"Cells" | b"CellData") => {
                 section = Section::Other;
             }
@@ -177,7 +181,13 @@ fn read_root(bytes: &[u8], e: &BytesStart, at: usize, file: &mut VtuFile) -> Res
     file.layout.compressed = match attribute(e, "compressor").as_deref() {
         None | Some("") => false,
         Some("vtkZLibDataCompressor") => true,
-        Some(c) => return Err(error_at(bytes, at, format!("unsupported compressor '{c}' (only vtkZLibDataCompressor)"))),
+        Some(c) => {
+            return Err(error_at(
+                bytes,
+                at,
+                format!("unsupported compressor '{c}' (only vtkZLibDataCompressor)"),
+            ))
+        }
     };
     Ok(())
 }
@@ -187,20 +197,28 @@ fn count_attribute(bytes: &[u8], e: &BytesStart, at: usize, name: &str) -> Resul
     value.trim().parse().map_err(|_| error_at(bytes, at, format!("{name}=\"{value}\" is not a count")))
 }
 
-fn data_array<'a>(bytes: &[u8], e: &BytesStart, at: usize, section: Section) -> Result<Array<'a>, ParseError> {
+fn data_array<'a>(
+    bytes: &[u8],
+    e: &BytesStart,
+    at: usize,
+    section: Section,
+) -> Result<Array<'a>, ParseError> {
     let ty_name = attribute(e, "type").unwrap_or_default();
     let ty = Scalar::parse(&ty_name)
         .ok_or_else(|| error_at(bytes, at, format!("DataArray of unsupported type '{ty_name}'")))?;
     let components = match attribute(e, "NumberOfComponents") {
         None => 1,
-        Some(c) => c.trim().parse().map_err(|_| error_at(bytes, at, format!("bad NumberOfComponents '{c}'")))?,
+        Some(c) => {
+            c.trim().parse().map_err(|_| error_at(bytes, at, format!("bad NumberOfComponents '{c}'")))?
+        }
     };
     let format = match attribute(e, "format").as_deref() {
         Some("ascii") => Format::Ascii,
         Some("binary") => Format::Binary,
         Some("appended") => {
             let offset = attribute(e, "offset").unwrap_or_default();
-            let offset = offset.trim().parse().map_err(|_| error_at(bytes, at, format!("bad offset '{offset}'")))?;
+            let offset =
+                offset.trim().parse().map_err(|_| error_at(bytes, at, format!("bad offset '{offset}'")))?;
             Format::Appended(offset)
         }
         other => return Err(error_at(bytes, at, format!("DataArray of unknown format {other:?}"))),
@@ -233,11 +251,22 @@ impl<'a> VtuFile<'a> {
                 Ok(Raw::Binary(data::block(&decoded, self.layout).map_err(fail)?.0))
             }
             Format::Appended(offset) => {
-                let app = self.appended.as_ref().ok_or_else(|| fail("appended array but no <AppendedData>".into()))?;
-                let rest = app.data.get(offset..).ok_or_else(|| fail(format!("offset {offset} past the appended data")))?;
-                let bytes = if app.raw { rest.to_vec() } else { data::base64(self.base64_run(rest, offset)).map_err(fail)? };
-                let (data, _) = data::block(&bytes, self.layout)
-                    .map_err(|m| ParseError::at_byte((app.at + offset) as u64, format!("DataArray '{}': {m}", array.name)))?;
+                let app = self
+                    .appended
+                    .as_ref()
+                    .ok_or_else(|| fail("appended array but no <AppendedData>".into()))?;
+                let rest = app
+                    .data
+                    .get(offset..)
+                    .ok_or_else(|| fail(format!("offset {offset} past the appended data")))?;
+                let bytes = if app.raw {
+                    rest.to_vec()
+                } else {
+                    data::base64(self.base64_run(rest, offset)).map_err(fail)?
+                };
+                let (data, _) = data::block(&bytes, self.layout).map_err(|m| {
+                    ParseError::at_byte((app.at + offset) as u64, format!("DataArray '{}': {m}", array.name))
+                })?;
                 Ok(Raw::Binary(data))
             }
         }

@@ -142,17 +142,27 @@ fn meshio_files() {
 fn appended(raw: bool) -> Vec<u8> {
     let b64 = |d: &[u8]| base64::Engine::encode(&base64::engine::general_purpose::STANDARD, d);
     let arrays: [(&str, &str, Vec<u8>); 4] = [
-        ("Float64\" NumberOfComponents=\"3", "Points", [0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1.].iter().flat_map(|v: &f64| v.to_le_bytes()).collect()),
+        (
+            "Float64\" NumberOfComponents=\"3",
+            "Points",
+            [0., 0., 0., 1., 0., 0., 0., 1., 0., 0., 0., 1.]
+                .iter()
+                .flat_map(|v: &f64| v.to_le_bytes())
+                .collect(),
+        ),
         ("Int64", "connectivity", [0i64, 1, 2, 3].iter().flat_map(|v| v.to_le_bytes()).collect()),
         ("Int64", "offsets", 4i64.to_le_bytes().to_vec()),
         ("UInt8", "types", vec![10]),
     ];
-    let mut xml = String::from("<VTKFile type=\"UnstructuredGrid\" header_type=\"UInt64\"><UnstructuredGrid>\n");
+    let mut xml =
+        String::from("<VTKFile type=\"UnstructuredGrid\" header_type=\"UInt64\"><UnstructuredGrid>\n");
     xml += "<Piece NumberOfPoints=\"4\" NumberOfCells=\"1\">\n";
     let mut data: Vec<u8> = Vec::new();
     for (i, (ty, name, bytes)) in arrays.iter().enumerate() {
-        let section = match i { 0 => "Points", _ => "Cells" };
-        xml += &format!("<{section}><DataArray type=\"{ty}\" Name=\"{name}\" format=\"appended\" offset=\"{}\"/></{section}>\n", data.len());
+        let section = if i == 0 { "Points" } else { "Cells" };
+        let offset = data.len();
+        let attributes = format!("type=\"{ty}\" Name=\"{name}\" format=\"appended\" offset=\"{offset}\"");
+        xml += &format!("<{section}><DataArray {attributes}/></{section}>\n");
         let header = (bytes.len() as u64).to_le_bytes();
         if raw {
             data.extend_from_slice(&header);
@@ -163,7 +173,8 @@ fn appended(raw: bool) -> Vec<u8> {
         }
     }
     let encoding = if raw { "raw" } else { "base64" };
-    let mut out = format!("{xml}</Piece></UnstructuredGrid>\n<AppendedData encoding=\"{encoding}\">\n_").into_bytes();
+    let mut out =
+        format!("{xml}</Piece></UnstructuredGrid>\n<AppendedData encoding=\"{encoding}\">\n_").into_bytes();
     out.extend_from_slice(&data);
     out.extend_from_slice(b"\n</AppendedData></VTKFile>\n");
     out
@@ -189,9 +200,14 @@ fn errors_name_the_problem_and_the_line() {
     assert!(e.message.contains("unsupported VTK cell type 42"), "{e}");
     let e = parse(ASCII.replace("4 7 9", "4 7").as_bytes()).unwrap_err();
     assert!(e.message.contains("'offsets': 2 values for 3 cells"), "{e}");
-    let e = parse(MESHIO_ZLIB.replace("eJxjYIAARijNBKWZGVABE5o6AAFAAAo=", "AAxjYIAARijNBKWZGVABE5o6AAFAAAo=").as_bytes());
+    let e = parse(
+        MESHIO_ZLIB
+            .replace("eJxjYIAARijNBKWZGVABE5o6AAFAAAo=", "AAxjYIAARijNBKWZGVABE5o6AAFAAAo=")
+            .as_bytes(),
+    );
     assert!(e.unwrap_err().message.contains("zlib"));
-    let e = parse(MESHIO_BINARY.replace("EAAAAAQAAAAAAAAABwAAAAAAAAA=", "EAAAAAQAAAAAAAAA").as_bytes()).unwrap_err();
+    let e = parse(MESHIO_BINARY.replace("EAAAAAQAAAAAAAAABwAAAAAAAAA=", "EAAAAAQAAAAAAAAA").as_bytes())
+        .unwrap_err();
     assert!(e.message.contains("truncated"), "{e}");
     assert!(parse(b"<VTKFile type=\"PolyData\">").unwrap_err().message.contains("PolyData"));
     assert!(parse(b"not xml at all").unwrap_err().message.contains("VTKFile"));
@@ -199,7 +215,10 @@ fn errors_name_the_problem_and_the_line() {
 
 proptest::proptest! {
     #[test]
-    fn arbitrary_damage_never_panics(cut in 0usize..8000, flips in proptest::collection::vec((0usize..8000, 0u8..=255), 0..4)) {
+    fn arbitrary_damage_never_panics(
+        cut in 0usize..8000,
+        flips in proptest::collection::vec((0usize..8000, 0u8..=255), 0..4),
+    ) {
         let ours = write_to_vec(&hybrid_column());
         for mut bytes in [ours, MESHIO_ZLIB.as_bytes().to_vec(), appended(true), appended(false)] {
             for &(at, b) in &flips {

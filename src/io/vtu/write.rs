@@ -20,7 +20,10 @@ fn binary_array(
     bytes: usize,
     values: impl FnOnce(&mut dyn Write) -> io::Result<()>,
 ) -> io::Result<()> {
-    writeln!(w, r#"<DataArray type="{ty}" Name="{name}" NumberOfComponents="{components}" format="binary">"#)?;
+    writeln!(
+        w,
+        r#"<DataArray type="{ty}" Name="{name}" NumberOfComponents="{components}" format="binary">"#
+    )?;
     {
         let mut encoder = EncoderWriter::new(&mut *w, &STANDARD);
         encoder.write_all(&(bytes as u64).to_le_bytes())?;
@@ -35,10 +38,18 @@ pub fn write(w: &mut dyn Write, mesh: &VolumeMesh) -> io::Result<()> {
     let b = &mesh.boundary;
     let faces = b.triangles.len() + b.quads.len();
     let cells = mesh.cell_count() + faces;
-    let nodes: usize = mesh.blocks.iter().map(|b| b.nodes.len()).sum::<usize>() + 3 * b.triangles.len() + 4 * b.quads.len();
+    let nodes: usize =
+        mesh.blocks.iter().map(|b| b.nodes.len()).sum::<usize>() + 3 * b.triangles.len() + 4 * b.quads.len();
     writeln!(w, r#"<?xml version="1.0"?>"#)?;
-    writeln!(w, r#"<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">"#)?;
-    writeln!(w, "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\">", mesh.points.len())?;
+    writeln!(
+        w,
+        r#"<VTKFile type="UnstructuredGrid" version="1.0" byte_order="LittleEndian" header_type="UInt64">"#
+    )?;
+    writeln!(
+        w,
+        "<UnstructuredGrid>\n<Piece NumberOfPoints=\"{}\" NumberOfCells=\"{cells}\">",
+        mesh.points.len()
+    )?;
     writeln!(w, "<Points>")?;
     binary_array(w, "Float64", "Points", 3, 24 * mesh.points.len(), |e| {
         mesh.points.iter().flat_map(|p| p.to_array()).try_for_each(|v| e.write_all(&v.to_le_bytes()))
@@ -56,7 +67,9 @@ pub fn write(w: &mut dyn Write, mesh: &VolumeMesh) -> io::Result<()> {
     })?;
     binary_array(w, "Int64", "offsets", 1, 8 * cells, |e| {
         let sizes = mesh.blocks.iter().flat_map(|b| std::iter::repeat_n(b.kind.node_count(), b.len()));
-        let sizes = sizes.chain(std::iter::repeat_n(3, b.triangles.len())).chain(std::iter::repeat_n(4, b.quads.len()));
+        let sizes = sizes
+            .chain(std::iter::repeat_n(3, b.triangles.len()))
+            .chain(std::iter::repeat_n(4, b.quads.len()));
         let mut end = 0i64;
         sizes.into_iter().try_for_each(|n| {
             end += n as i64;
