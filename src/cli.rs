@@ -1,5 +1,198 @@
-//! The `blmesh` command line (to be filled in).
+//! The `blmesh` command line: `info`, `check` and `mesh`.
+//!
+//! Errors are printed as one message naming the problem and exit with a non-zero code; outputs
+//! are written atomically, so a failed run leaves no partial file.
 
-pub fn main() -> i32 {
-    0
+use std::path::{Path, PathBuf};
+use std::process::ExitCode;
+
+use anyhow::{bail, Context, Result};
+use clap::{Args, Parser, Subcommand};
+
+use crate::config::{Config, LayerCount};
+use crate::io::{self, MeshFormat};
+use crate::pipeline::{self, MeshOptions};
+use crate::progress::Progress;
+use crate::quality;
+use crate::surface::info::SurfaceInfo;
+
+/// Exit code for invalid input or a failed run (clap itself uses 2 for bad usage).
+const EXIT_FAILURE: u8 = 1;
+
+#[derive(Parser, Debug)]
+#[command(name = "blmesh", version, about = "Boundary-layer volume meshes for CFD")]
+struct Cli {
+    /// Print no progress and no summary (errors are still printed).
+    #[arg(short, long, global = true)]
+    quiet: bool,
+    /// More log output (-v info, -vv debug).
+    #[arg(short, long, global = true, action = clap::ArgAction::Count)]
+    verbose: u8,
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+enum Command {
+    /// Read and validate a surface; print its topology, patches and features.
+    Info {
+        surface: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+        /// Edges turning more than this (degrees) are ridges.
+        #[arg(long, default_value_t = crate::config::DEFAULT_FEATURE_ANGLE)]
+        feature_angle: f64,
+    },
+    /// Check a volume mesh (.msh, .vtu): positive volumes, conformity, volume identity, quality.
+    /// Exits with 0 only when the mesh is valid.
+    Check {
+        mesh: PathBuf,
+        /// Print JSON instead of text.
+        #[arg(long)]
+        json: bool,
+    },
+    /// Build the boundary-layer mesh of a surface.
+    Mesh(MeshArgs),
+}
+
+#[derive(Args, Debug)]
+struct MeshArgs {
+    /// Input surface (.stl, .obj, .off, .msh, .mesh, .meshb, .tri, .uh3d).
+    input: PathBuf,
+    /// Output mesh; the format follows the extension (.msh, .vtu).
+    #[arg(short, long)]
+    output: PathBuf,
+    /// TOML configuration file (flags override it).
+    #[arg(long)]
+    config: Option<PathBuf>,
+    /// First layer height h0 (surface units).
+    #[arg(long)]
+    first_height: Option<f64>,
+    /// Growth ratio r (layer k is h0 r^k high).
+    #[arg(long)]
+    growth: Option<f64>,
+    /// Number of layers, or "auto" to stop where cells become isotropic.
+    #[arg(long)]
+    layers: Option<LayerCount>,
+    /// Total layer thickness (instead of --layers).
+    #[arg(long, conflicts_with = "layers")]
+    thickness: Option<f64>,
+    /// Edges turning more than this (degrees) are ridges.
+    #[arg(long)]
+    feature_angle: Option<f64>,
+    /// Largest angle (degrees) between neighbouring normals of a fan at a convex ridge.
+    #[arg(long)]
+    fan_angle: Option<f64>,
+    /// Write only the layers (no core tetrahedra).
+    #[arg(long)]
+    no_core: bool,
+    /// Write MSH as ASCII instead of binary.
+    #[arg(long)]
+    ascii: bool,
+    /// Also write the run's report as JSON.
+    #[arg(long)]
+    report: Option<PathBuf>,
+}
+
+/// Run the command line; returns the process exit code.
+pub fn main() -> ExitCode {
+    let cli = match Cli::try_parse() {
+        Ok(cli) => cli,
+        Err(e) => {
+            let _ = e.print();
+            return ExitCode::from(if e.use_stderr() { 2 } else { 0 });
+        }
+    };
+    init_logging(cli.verbose);
+    let progress = Progress::new(cli.quiet);
+    let result = match cli.command {
+        Command::Info { surface, json, feature_angle } => info(&surface, json, feature_angle),
+        Command::Check { mesh, json } => check(&mesh, json),
+        Command::Mesh(args) => mesh(&args, cli.quiet, progress),
+    };
+    match result {
+        Ok(code) => code,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::from(EXIT_FAILURE)
+        }
+    }
+}
+
+fn init_logging(verbose: u8) {
+    let level = match verbose {
+        0 => "warn",
+        1 => "info",
+        _ => "debug",
+    };
+    let filter = tracing_subscriber::EnvFilter::try_from_default_env()
+        .unwrap_or_else(|_| tracing_subscriber::EnvFilter::new(level));
+    let _ = tracing_subscriber::fmt().with_env_filter(filter).with_writer(std::io::stderr).try_init();
+}
+
+fn info(path: &Path, json: bool, feature_angle: f64) -> Result<ExitCode> {
+    if !(feature_angle > 0.0 && feature_angle < 180.0) {
+        bail!("--feature-angle {feature_angle} must be between 0 and 180 degrees");
+    }
+    let surface = io::read_surface(path)?;
+    let info = SurfaceInfo::compute(&surface, feature_angle);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&info)?);
+    } else {
+        println!("{}\n{info}", path.display());
+    }
+    let valid = matches!(info.validation, crate::surface::info::ValidationSummary::Valid { .. });
+    Ok(if valid { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
+}
+
+fn check(path: &Path, json: bool) -> Result<ExitCode> {
+    let mesh = io::read_volume_mesh(path)?;
+    let report = quality::check(&mesh);
+    if json {
+        println!("{}", serde_json::to_string_pretty(&report)?);
+    } else {
+        println!("{}\n{report}", path.display());
+    }
+    Ok(if report.is_valid() { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
+}
+
+fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
+    let format = MeshFormat::from_path(&args.output, args.ascii).with_context(|| {
+        format!("{}: unknown output format (expected .msh or .vtu)", args.output.display())
+    })?;
+    let config = mesh_config(args)?;
+    let surface = io::read_surface(&args.input)?;
+    let options = MeshOptions { core: !args.no_core };
+    let out = pipeline::run(surface, &config, &options, progress)?;
+    io::write_volume_mesh(&args.output, &out.mesh, format)
+        .with_context(|| format!("{}: cannot write", args.output.display()))?;
+    if let Some(report_path) = &args.report {
+        let text = serde_json::to_string_pretty(&out.report)?;
+        io::write_atomic(report_path, |w| w.write_all(text.as_bytes()))
+            .with_context(|| format!("{}: cannot write", report_path.display()))?;
+    }
+    if !quiet {
+        println!("{}", out.report);
+    }
+    Ok(ExitCode::SUCCESS)
+}
+
+/// The config file (if any) with the command-line flags on top, validated.
+fn mesh_config(args: &MeshArgs) -> Result<Config> {
+    let mut config = match &args.config {
+        Some(path) => Config::from_toml_file(path)?,
+        None => Config::default(),
+    };
+    let flags = &mut config.layers;
+    flags.first_height = args.first_height.or(flags.first_height);
+    flags.growth = args.growth.or(flags.growth);
+    if args.layers.is_some() || args.thickness.is_some() {
+        flags.count = args.layers;
+        flags.thickness = args.thickness;
+    }
+    config.feature_angle = args.feature_angle.or(config.feature_angle);
+    config.fan_angle = args.fan_angle.or(config.fan_angle);
+    config.validate()?;
+    Ok(config)
 }

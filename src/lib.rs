@@ -17,5 +17,7 @@ pub mod io;
 pub mod layers;
 pub mod mesh;
 pub mod normals;
+pub mod pipeline;
+pub mod progress;
 pub mod quality;
 pub mod surface;

@@ -1,3 +1,3 @@
-fn main() {
-    std::process::exit(blmesh::cli::main());
+fn main() -> std::process::ExitCode {
+    blmesh::cli::main()
 }

@@ -1,3 +1,132 @@
 //! Layer marching: columns, the front, and the slab of cells between two fronts.
+//!
+//! [`build_layers`] turns the wall and its extrusion directions into the layered part of the
+//! mesh: the wall points, the layer cells (zone [`march::LAYER_ZONE`]), the wall faces under
+//! them and the final front as the boundary patch [`TOP_PATCH`].
 
+pub mod front;
+pub mod march;
 pub mod slab;
+
+use crate::config::LayerSpec;
+use crate::mesh::VolumeMesh;
+use crate::normals::WallNormals;
+use crate::surface::Surface;
+
+pub use march::MarchStats;
+
+/// Name of the boundary patch made of the top faces of the layers.
+pub const TOP_PATCH: &str = "bl_top";
+/// Name of the volume zone of the layer cells.
+pub const LAYER_ZONE_NAME: &str = "boundary_layer";
+
+/// The layered mesh and what happened while marching.
+#[derive(Clone, Debug)]
+pub struct Layers {
+    pub mesh: VolumeMesh,
+    pub stats: MarchStats,
+    /// Layers reached by every wall vertex (the fewest over its columns); `None` for vertices
+    /// that get no layers.
+    pub vertex_layers: Vec<Option<u32>>,
+    /// Target layer count of every wall vertex.
+    pub vertex_target: Vec<Option<u32>>,
+    /// Where columns stopped early: wall vertex ids (all of them; the report shows a few).
+    pub stopped_vertices: Vec<u32>,
+}
+
+/// Extrude the wall. `patch_spec[p]` is the layer stack of patch `p`, `None` for patches
+/// without layers (their vertices do not move).
+pub fn build_layers(
+    surface: &Surface,
+    normals: &WallNormals,
+    patch_spec: &[Option<LayerSpec>],
+    mut on_layer: impl FnMut(u32, u32),
+) -> Layers {
+    let (mut columns, mut front) = front::initial_front(surface, normals);
+    let column_spec = column_specs(normals, &front, patch_spec);
+    for (c, spec) in column_spec.iter().enumerate() {
+        columns.alive[c] = spec.is_some();
+    }
+    let target = |c: usize| column_spec[c].map(|s| s.fixed_count().unwrap_or(0));
+    let max_layers = (0..columns.len()).filter_map(target).max().unwrap_or(0);
+    let mut mesh = VolumeMesh {
+        points: surface.points.clone(),
+        zone_names: vec![LAYER_ZONE_NAME.to_owned()],
+        ..Default::default()
+    };
+    let distance = |c: usize, k: u32| column_spec[c].filter(|_| k <= target(c).unwrap_or(0)).map(|s| s.distance(k));
+    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, distance, |k| {
+        on_layer(k, max_layers)
+    });
+    add_boundary(&mut mesh, surface, &front, &columns);
+    let mut vertex_layers: Vec<Option<u32>> = vec![None; surface.points.len()];
+    let mut vertex_target: Vec<Option<u32>> = vec![None; surface.points.len()];
+    let mut stopped_vertices = Vec::new();
+    for c in 0..columns.len() {
+        let v = columns.wall_vertex[c] as usize;
+        if let Some(t) = target(c) {
+            vertex_layers[v] = Some(vertex_layers[v].map_or(columns.layers[c], |l| l.min(columns.layers[c])));
+            vertex_target[v] = Some(vertex_target[v].map_or(t, |x| x.max(t)));
+            if columns.layers[c] < t {
+                stopped_vertices.push(v as u32);
+            }
+        }
+    }
+    stopped_vertices.sort_unstable();
+    stopped_vertices.dedup();
+    Layers { mesh, stats, vertex_layers, vertex_target, stopped_vertices }
+}
+
+/// The layer stack of each column: that of the first front face using it, `None` if any face
+/// using it has no layers (a column on the border of a patch without layers does not move).
+fn column_specs(
+    normals: &WallNormals,
+    front: &front::Front,
+    patch_spec: &[Option<LayerSpec>],
+) -> Vec<Option<LayerSpec>> {
+    let mut spec: Vec<Option<Option<LayerSpec>>> = vec![None; normals.columns.len()];
+    for f in 0..front.len() {
+        let s = patch_spec.get(front.patch[f] as usize).copied().flatten();
+        for &c in front.face_columns(f) {
+            let slot = &mut spec[c as usize];
+            *slot = match (*slot, s) {
+                (None, s) => Some(s),
+                (Some(None), _) | (Some(Some(_)), None) => Some(None),
+                (Some(Some(a)), Some(_)) => Some(Some(a)),
+            };
+        }
+    }
+    spec.into_iter().map(Option::flatten).collect()
+}
+
+/// Boundary faces of the layered mesh: the wall triangles with a cell on them (oriented out of
+/// the domain, i.e. into the body) and the raised front faces (patch [`TOP_PATCH`]).
+fn add_boundary(mesh: &mut VolumeMesh, surface: &Surface, front: &front::Front, columns: &front::Columns) {
+    mesh.patch_names = surface.patch_names.clone();
+    let top_patch = mesh.patch_names.len() as u32;
+    mesh.patch_names.push(TOP_PATCH.to_owned());
+    for t in 0..surface.triangles.len() {
+        if front.raised[t] {
+            let [a, b, c] = surface.triangles[t];
+            mesh.boundary.triangles.push([a, c, b]);
+            mesh.boundary.triangle_patch.push(surface.triangle_patch[t]);
+        }
+    }
+    for f in 0..front.len() {
+        if !front.raised[f] {
+            continue;
+        }
+        let nodes: Vec<u32> = front.face_columns(f).iter().map(|&c| columns.node[c as usize]).collect();
+        match crate::layers::slab::Polygon::dedup(&nodes).as_ref().map(|p| p.nodes()) {
+            Some(&[a, b, c]) => {
+                mesh.boundary.triangles.push([a, b, c]);
+                mesh.boundary.triangle_patch.push(top_patch);
+            }
+            Some(&[a, b, c, d]) => {
+                mesh.boundary.quads.push([a, b, c, d]);
+                mesh.boundary.quad_patch.push(top_patch);
+            }
+            _ => {}
+        }
+    }
+}

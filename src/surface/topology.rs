@@ -93,6 +93,17 @@ impl Topology {
         &self.edge_uses[self.edge_use_start[e] as usize..self.edge_use_start[e + 1] as usize]
     }
 
+    /// The triangle across edge `e` from triangle `t` (`t` itself on an open edge).
+    pub fn other_triangle(&self, e: u32, t: u32) -> u32 {
+        self.edge_uses(e).iter().map(|u| u.triangle).find(|&x| x != t).unwrap_or(t)
+    }
+
+    /// The triangle that runs along edge `e` from vertex `from` to vertex `to`.
+    pub fn triangle_using(&self, e: u32, from: u32, to: u32) -> u32 {
+        let forward = self.edges[e as usize] == [from, to];
+        self.edge_uses(e).iter().find(|u| u.forward == forward).map_or(u32::MAX, |u| u.triangle)
+    }
+
     /// The triangles having `v` as a corner, sorted by triangle id.
     pub fn vertex_triangles(&self, v: u32) -> &[u32] {
         let v = v as usize;

@@ -1,0 +1,133 @@
+//! The marching front: columns (one per extrusion direction of a wall vertex) and the front
+//! faces over them (the wall triangles, plus the fan strips and corner patches of convex ridges).
+
+use crate::geometry::DVec3;
+use crate::normals::WallNormals;
+use crate::surface::Surface;
+
+/// Struct-of-arrays of columns: a wall vertex (or a fan copy of it) followed through the layers.
+#[derive(Clone, Debug, Default)]
+pub struct Columns {
+    /// Wall position the column starts from.
+    pub base: Vec<DVec3>,
+    /// Unit extrusion direction.
+    pub dir: Vec<DVec3>,
+    /// Distance multiplier along `dir` (1 / min cosine with the incident faces).
+    pub scale: Vec<f64>,
+    /// The mesh node the column is at now.
+    pub node: Vec<u32>,
+    /// Still marching.
+    pub alive: Vec<bool>,
+    /// Layers completed.
+    pub layers: Vec<u32>,
+    /// The wall vertex the column grows from.
+    pub wall_vertex: Vec<u32>,
+}
+
+impl Columns {
+    pub fn len(&self) -> usize {
+        self.base.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.base.is_empty()
+    }
+}
+
+/// The front: triangles and quads of columns, oriented with their normal into the fluid.
+#[derive(Clone, Debug, Default)]
+pub struct Front {
+    columns: Vec<[u32; 4]>,
+    sizes: Vec<u8>,
+    /// Input patch of every face (fan faces take the patch of a neighbouring triangle).
+    pub patch: Vec<u32>,
+    /// The face has had a cell emitted under it: it is now a top face of the layers.
+    pub raised: Vec<bool>,
+    /// Faces around each column (CSR).
+    column_face_offsets: Vec<u32>,
+    column_faces: Vec<u32>,
+}
+
+impl Front {
+    pub fn len(&self) -> usize {
+        self.sizes.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.sizes.is_empty()
+    }
+
+    pub fn push(&mut self, columns: &[u32], patch: u32) {
+        let mut c = [0; 4];
+        c[..columns.len()].copy_from_slice(columns);
+        self.columns.push(c);
+        self.sizes.push(columns.len() as u8);
+        self.patch.push(patch);
+        self.raised.push(false);
+    }
+
+    pub fn face_columns(&self, f: usize) -> &[u32] {
+        &self.columns[f][..self.sizes[f] as usize]
+    }
+
+    /// Build the column -> faces adjacency (after all faces are pushed).
+    pub fn index_columns(&mut self, column_count: usize) {
+        let mut counts = vec![0u32; column_count + 1];
+        for f in 0..self.len() {
+            for &c in self.face_columns(f) {
+                counts[c as usize + 1] += 1;
+            }
+        }
+        for i in 0..column_count {
+            counts[i + 1] += counts[i];
+        }
+        let mut fill = counts.clone();
+        let mut faces = vec![0u32; counts[column_count] as usize];
+        for f in 0..self.len() {
+            for &c in self.face_columns(f) {
+                faces[fill[c as usize] as usize] = f as u32;
+                fill[c as usize] += 1;
+            }
+        }
+        self.column_face_offsets = counts;
+        self.column_faces = faces;
+    }
+
+    /// The faces touching any of `columns`, each once.
+    pub fn faces_around_columns(&self, columns: &[u32]) -> Vec<usize> {
+        let mut faces: Vec<usize> = columns
+            .iter()
+            .flat_map(|&c| {
+                let (lo, hi) = (self.column_face_offsets[c as usize], self.column_face_offsets[c as usize + 1]);
+                self.column_faces[lo as usize..hi as usize].iter().map(|&f| f as usize)
+            })
+            .collect();
+        faces.sort_unstable();
+        faces.dedup();
+        faces
+    }
+}
+
+/// The initial front on the wall: one column per extrusion direction, the wall triangles over
+/// the columns of their corners, and the fan faces.
+pub fn initial_front(surface: &Surface, normals: &WallNormals) -> (Columns, Front) {
+    let mut columns = Columns::default();
+    for seed in &normals.columns {
+        columns.base.push(surface.points[seed.vertex as usize]);
+        columns.dir.push(seed.direction);
+        columns.scale.push(seed.scale);
+        columns.node.push(seed.vertex);
+        columns.alive.push(true);
+        columns.layers.push(0);
+        columns.wall_vertex.push(seed.vertex);
+    }
+    let mut front = Front::default();
+    for (t, corner_columns) in normals.triangle_columns.iter().enumerate() {
+        front.push(corner_columns, surface.triangle_patch[t]);
+    }
+    for fan in &normals.fan_faces {
+        front.push(fan.columns(), fan.patch);
+    }
+    front.index_columns(columns.len());
+    (columns, front)
+}

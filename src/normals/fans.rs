@@ -1,0 +1,443 @@
+//! Columns at wall vertices: one most-normal column per sector, fans across convex ridges,
+//! spherical patches at convex corners.
+//!
+//! Around a vertex, the convex ridge edges ("fan edges") cut the ring of incident triangles
+//! into sectors; each sector gets one column along the most normal direction of its triangles.
+//! Across a fan edge (v, w) the front opens like the exact offset (a cylinder): a strip of quads
+//! joins `m + 1` columns at v to `m + 1` columns at w, their directions turning from one sector's
+//! direction to the other's in steps of at most the fan angle. `m` is the same along a whole
+//! ridge line, so that ridge vertices share their fan columns between their two ridge edges.
+//! Where three or more fan edges meet (a convex corner), the hole left between the strips is a
+//! spherical polygon of directions, filled by a web of rings around its most normal direction
+//! (the exact offset there is a sphere).
+//!
+//! Strip orientation: for a fan edge used as v -> w by triangle `t1` and w -> v by `t2`, fan index
+//! 0 is on `t1`'s side; quad j is `(w_j, v_j, v_j+1, w_j+1)`, which runs along the shared column
+//! edges opposite to `t1` and `t2`, so the front stays consistently oriented.
+
+use glam::DVec3;
+
+use super::most_normal::most_normal;
+use crate::surface::features::{EdgeKind, Features};
+use crate::surface::topology::Topology;
+use crate::surface::Surface;
+
+/// One column to extrude: from wall vertex `vertex` along `direction`, `scale` times the layer
+/// distance.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ColumnSeed {
+    pub vertex: u32,
+    pub direction: DVec3,
+    pub scale: f64,
+}
+
+/// A face of a fan strip or corner patch: 3 or 4 columns, oriented into the fluid.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct FanFace {
+    cols: [u32; 4],
+    len: u8,
+    pub patch: u32,
+}
+
+impl FanFace {
+    fn new(cols: &[u32], patch: u32) -> Self {
+        let mut c = [0; 4];
+        c[..cols.len()].copy_from_slice(cols);
+        FanFace { cols: c, len: cols.len() as u8, patch }
+    }
+
+    pub fn columns(&self) -> &[u32] {
+        &self.cols[..self.len as usize]
+    }
+}
+
+/// Counts for the report.
+#[derive(Clone, Debug, Default, serde::Serialize)]
+pub struct NormalStats {
+    pub columns: usize,
+    pub fan_columns: usize,
+    pub fan_edges: usize,
+    pub corner_patches: usize,
+    /// Sectors where no single direction sees all their faces (an angle-weighted normal is used).
+    pub no_common_normal: usize,
+}
+
+/// The extrusion directions of the whole wall.
+#[derive(Clone, Debug, Default)]
+pub struct WallNormals {
+    pub columns: Vec<ColumnSeed>,
+    /// The column of each corner of each wall triangle.
+    pub triangle_columns: Vec<[u32; 3]>,
+    pub fan_faces: Vec<FanFace>,
+    pub stats: NormalStats,
+}
+
+/// Triangles around a vertex in counter-clockwise order (seen from the fluid), each with its
+/// corner index at the vertex; `cut_after[i]` is the edge between triangle i and i + 1.
+struct Ring {
+    triangles: Vec<(u32, usize)>,
+    edge_after: Vec<u32>,
+}
+
+fn vertex_ring(surface: &Surface, topology: &Topology, v: u32) -> Ring {
+    let incident = topology.vertex_triangles(v);
+    let corner = |t: u32| surface.triangles[t as usize].iter().position(|&x| x == v).unwrap_or(0);
+    let mut triangles = Vec::with_capacity(incident.len());
+    let mut edge_after = Vec::with_capacity(incident.len());
+    let mut t = incident[0];
+    for _ in 0..incident.len() {
+        let i = corner(t);
+        // t = (v, a, b): the next triangle around v uses the edge (v, b) as v -> b.
+        let edge = topology.triangle_edges[t as usize][(i + 2) % 3];
+        triangles.push((t, i));
+        edge_after.push(edge);
+        t = topology.other_triangle(edge, t);
+    }
+    Ring { triangles, edge_after }
+}
+
+/// Build the columns and fan faces of the wall.
+pub fn wall_normals(surface: &Surface, topology: &Topology, features: &Features, fan_angle_deg: f64) -> WallNormals {
+    let fan_angle = fan_angle_deg.to_radians();
+    let mut out = WallNormals {
+        triangle_columns: vec![[u32::MAX; 3]; surface.triangles.len()],
+        ..Default::default()
+    };
+    let is_fan_edge = |e: u32| features.edge_kind[e as usize] == EdgeKind::ConvexRidge;
+    // Per (vertex, fan edge): the sector columns on the edge's t1 side (index 0) and t2 side.
+    let mut fan_ends: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); surface.points.len()];
+    for v in 0..surface.points.len() as u32 {
+        if topology.vertex_triangles(v).is_empty() {
+            continue;
+        }
+        let ring = vertex_ring(surface, topology, v);
+        sector_columns(surface, topology, v, &ring, &is_fan_edge, &mut out, &mut fan_ends[v as usize]);
+    }
+    let fan_edges: Vec<u32> = (0..topology.edge_count() as u32).filter(|&e| is_fan_edge(e)).collect();
+    let segments = fan_segments(topology, &fan_edges, &fan_ends, &out.columns, fan_angle);
+    let fans = fan_columns(topology, &fan_edges, &segments, &fan_ends, &mut out);
+    strips(surface, topology, &fan_edges, &segments, &fans, &mut out);
+    corner_patches(surface, topology, &fan_edges, &fan_ends, &fans, fan_angle, &mut out);
+    out.stats.columns = out.columns.len();
+    out.stats.fan_edges = fan_edges.len();
+    out
+}
+
+/// One column per sector of the ring; records the columns on both sides of each fan edge.
+fn sector_columns(
+    surface: &Surface,
+    topology: &Topology,
+    v: u32,
+    ring: &Ring,
+    is_fan_edge: &impl Fn(u32) -> bool,
+    out: &mut WallNormals,
+    ends: &mut Vec<(u32, u32, u32)>,
+) {
+    let n = ring.triangles.len();
+    // Start the walk just after a fan edge, so each sector is contiguous.
+    let start = (0..n).find(|&i| is_fan_edge(ring.edge_after[i])).map_or(0, |i| (i + 1) % n);
+    let mut sector: Vec<(u32, usize)> = Vec::new();
+    let mut sector_col_of_ring = vec![0u32; n];
+    for step in 0..n {
+        let i = (start + step) % n;
+        sector.push(ring.triangles[i]);
+        if is_fan_edge(ring.edge_after[i]) || step == n - 1 {
+            let col = push_sector_column(surface, v, &sector, out);
+            for k in 0..sector.len() {
+                sector_col_of_ring[(i + n - k) % n] = col;
+            }
+            sector.clear();
+        }
+    }
+    for i in 0..n {
+        let e = ring.edge_after[i];
+        if is_fan_edge(e) {
+            // The triangle after e in the ring uses e as v -> other, so it is t1 (which runs
+            // from edges[e][0] to edges[e][1]) when v is the edge's first vertex.
+            let (after, before) = (sector_col_of_ring[(i + 1) % n], sector_col_of_ring[i]);
+            ends.push(if topology.edges[e as usize][0] == v { (e, after, before) } else { (e, before, after) });
+        }
+    }
+}
+
+fn push_sector_column(surface: &Surface, v: u32, sector: &[(u32, usize)], out: &mut WallNormals) -> u32 {
+    let normals: Vec<DVec3> = sector.iter().map(|&(t, _)| surface.triangle_normal(t as usize)).collect();
+    let (direction, scale) = match most_normal(&normals) {
+        Some(m) => (m.direction, m.extrusion_scale()),
+        None => {
+            out.stats.no_common_normal += 1;
+            (angle_weighted_normal(surface, sector), 1.0)
+        }
+    };
+    let col = out.columns.len() as u32;
+    out.columns.push(ColumnSeed { vertex: v, direction, scale });
+    for &(t, corner) in sector {
+        out.triangle_columns[t as usize][corner] = col;
+    }
+    col
+}
+
+fn angle_weighted_normal(surface: &Surface, sector: &[(u32, usize)]) -> DVec3 {
+    let mut sum = DVec3::ZERO;
+    for &(t, corner) in sector {
+        let p = surface.triangle_points(t as usize);
+        let (a, b, c) = (p[corner], p[(corner + 1) % 3], p[(corner + 2) % 3]);
+        let angle = (b - a).angle_between(c - a);
+        sum += angle * surface.triangle_normal(t as usize);
+    }
+    sum.normalize_or(surface.triangle_normal(sector[0].0 as usize))
+}
+
+/// Sector columns (t1 side, t2 side) of fan edge `e` at vertex `v`.
+fn ends_at(fan_ends: &[Vec<(u32, u32, u32)>], v: u32, e: u32) -> (u32, u32) {
+    fan_ends[v as usize].iter().find(|x| x.0 == e).map_or((u32::MAX, u32::MAX), |x| (x.1, x.2))
+}
+
+/// Number of fan segments `m` of every fan edge: enough for the fan angle at both ends, and
+/// the largest along each ridge line (chains of fan edges through vertices with two of them).
+fn fan_segments(
+    topology: &Topology,
+    fan_edges: &[u32],
+    fan_ends: &[Vec<(u32, u32, u32)>],
+    columns: &[ColumnSeed],
+    fan_angle: f64,
+) -> Vec<u32> {
+    let index_of = |e: u32| fan_edges.binary_search(&e).ok();
+    let mut m: Vec<u32> = fan_edges
+        .iter()
+        .map(|&e| {
+            let [v, w] = topology.edges[e as usize];
+            let angle = [v, w]
+                .iter()
+                .map(|&x| {
+                    let (a, b) = ends_at(fan_ends, x, e);
+                    columns[a as usize].direction.angle_between(columns[b as usize].direction)
+                })
+                .fold(0.0, f64::max);
+            ((angle / fan_angle).ceil() as u32).max(1)
+        })
+        .collect();
+    // Ridge lines: union the two fan edges of every vertex that has exactly two.
+    let mut parent: Vec<usize> = (0..fan_edges.len()).collect();
+    fn root(parent: &mut [usize], mut i: usize) -> usize {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    }
+    for ends in fan_ends.iter().filter(|ends| ends.len() == 2) {
+        if let (Some(a), Some(b)) = (index_of(ends[0].0), index_of(ends[1].0)) {
+            let (ra, rb) = (root(&mut parent, a), root(&mut parent, b));
+            parent[ra] = rb;
+        }
+    }
+    let mut line_max = vec![0u32; fan_edges.len()];
+    for i in 0..fan_edges.len() {
+        let r = root(&mut parent, i);
+        line_max[r] = line_max[r].max(m[i]);
+    }
+    for i in 0..fan_edges.len() {
+        m[i] = line_max[root(&mut parent, i)];
+    }
+    m
+}
+
+/// The m + 1 columns across each fan edge at each of its two ends (index 0 on t1's side).
+struct FanColumns {
+    /// Per fan edge (in `fan_edges` order): columns at [v, w] of `topology.edges[e as usize]`.
+    at: Vec<[Vec<u32>; 2]>,
+}
+
+fn fan_columns(
+    topology: &Topology,
+    fan_edges: &[u32],
+    segments: &[u32],
+    fan_ends: &[Vec<(u32, u32, u32)>],
+    out: &mut WallNormals,
+) -> FanColumns {
+    let mut at: Vec<[Vec<u32>; 2]> = vec![[Vec::new(), Vec::new()]; fan_edges.len()];
+    for (i, &e) in fan_edges.iter().enumerate() {
+        let m = segments[i] as usize;
+        for (side, &v) in topology.edges[e as usize].iter().enumerate() {
+            let ends = &fan_ends[v as usize];
+            let (a, b) = ends_at(fan_ends, v, e);
+            // A ridge vertex shares its fan between its two ridge edges, if the other edge's
+            // fan is already built between the same two sector columns.
+            let shared = (ends.len() == 2)
+                .then(|| ends.iter().find(|x| x.0 != e).map(|x| x.0))
+                .flatten()
+                .and_then(|other| {
+                    let j = fan_edges.binary_search(&other).ok()?;
+                    let side_other = topology.edges[other as usize].iter().position(|&x| x == v)?;
+                    let cols = &at[j][side_other];
+                    match (cols.first(), cols.last()) {
+                        _ if cols.len() != m + 1 => None,
+                        (Some(&x), Some(&y)) if (x, y) == (a, b) => Some(cols.clone()),
+                        (Some(&x), Some(&y)) if (x, y) == (b, a) => Some(cols.iter().rev().copied().collect()),
+                        _ => None,
+                    }
+                });
+            at[i][side] = match shared {
+                Some(cols) => cols,
+                None => interpolated_fan(v, a, b, m, out),
+            };
+        }
+    }
+    FanColumns { at }
+}
+
+/// Columns from `a` (index 0) to `b` (index m) at vertex v, new ones in between.
+fn interpolated_fan(v: u32, a: u32, b: u32, m: usize, out: &mut WallNormals) -> Vec<u32> {
+    let mut cols = vec![a];
+    let (da, db) = (out.columns[a as usize].direction, out.columns[b as usize].direction);
+    for j in 1..m {
+        let cols_len = out.columns.len() as u32;
+        let direction = if a == b { da } else { slerp(da, db, j as f64 / m as f64) };
+        if a == b {
+            cols.push(a); // A ridge ending here: the fan closes onto the single sector column.
+            continue;
+        }
+        out.columns.push(ColumnSeed { vertex: v, direction, scale: 1.0 });
+        out.stats.fan_columns += 1;
+        cols.push(cols_len);
+    }
+    cols.push(b);
+    cols
+}
+
+/// Spherical linear interpolation between unit vectors (falls back to a normalised lerp).
+fn slerp(a: DVec3, b: DVec3, t: f64) -> DVec3 {
+    let angle = a.angle_between(b);
+    if angle < 1e-9 || (std::f64::consts::PI - angle) < 1e-6 {
+        return a.lerp(b, t).normalize_or(a);
+    }
+    let s = angle.sin();
+    (a * ((1.0 - t) * angle).sin() / s + b * (t * angle).sin() / s).normalize()
+}
+
+fn strips(
+    surface: &Surface,
+    topology: &Topology,
+    fan_edges: &[u32],
+    segments: &[u32],
+    fans: &FanColumns,
+    out: &mut WallNormals,
+) {
+    for (i, &e) in fan_edges.iter().enumerate() {
+        let [v, w] = topology.edges[e as usize];
+        let t1 = topology.triangle_using(e, v, w);
+        let patch = surface.triangle_patch[t1 as usize];
+        let (vc, wc) = (&fans.at[i][0], &fans.at[i][1]);
+        for j in 0..segments[i] as usize {
+            out.fan_faces.push(FanFace::new(&[wc[j], vc[j], vc[j + 1], wc[j + 1]], patch));
+        }
+    }
+}
+
+/// Fill the hole at every vertex with three or more fan edges.
+fn corner_patches(
+    surface: &Surface,
+    topology: &Topology,
+    fan_edges: &[u32],
+    fan_ends: &[Vec<(u32, u32, u32)>],
+    fans: &FanColumns,
+    fan_angle: f64,
+    out: &mut WallNormals,
+) {
+    for (v, ends) in fan_ends.iter().enumerate() {
+        if ends.len() < 3 {
+            continue;
+        }
+        // Walking counter-clockwise, each fan edge is crossed from the sector before it to
+        // the sector after it: from index m to 0 where v is the edge's first vertex (the
+        // triangle after is t1), from 0 to m otherwise. Each fan adds all but its last column
+        // (the next fan starts with it).
+        let mut polygon = Vec::new();
+        for &(e, _, _) in ends {
+            let Ok(i) = fan_edges.binary_search(&e) else { continue };
+            let first = topology.edges[e as usize][0] as usize == v;
+            let cols = &fans.at[i][if first { 0 } else { 1 }];
+            if first {
+                polygon.extend(cols[1..].iter().rev().copied());
+            } else {
+                polygon.extend(cols[..cols.len() - 1].iter().copied());
+            }
+        }
+        let patch = surface.triangle_patch[topology.vertex_triangles(v as u32)[0] as usize];
+        web_patch(v as u32, &polygon, patch, fan_angle, out);
+        out.stats.corner_patches += 1;
+    }
+}
+
+/// Fill the spherical polygon of columns `polygon` (oriented as the front) with rings of new
+/// columns around its most normal direction, `fan_angle` apart at most along the spokes.
+fn web_patch(v: u32, polygon: &[u32], patch: u32, fan_angle: f64, out: &mut WallNormals) {
+    let dirs: Vec<DVec3> = polygon.iter().map(|&c| out.columns[c as usize].direction).collect();
+    let centre_dir = most_normal(&dirs).map_or_else(|| dirs.iter().sum::<DVec3>().normalize(), |m| m.direction);
+    let spoke = dirs.iter().map(|d| d.angle_between(centre_dir)).fold(0.0, f64::max);
+    let rings = ((spoke / fan_angle).ceil() as usize).max(1);
+    let new_column = |direction: DVec3, out: &mut WallNormals| {
+        out.columns.push(ColumnSeed { vertex: v, direction, scale: 1.0 });
+        out.stats.fan_columns += 1;
+        out.columns.len() as u32 - 1
+    };
+    let centre = new_column(centre_dir, out);
+    // ring[l][i]: l = 1..rings-1 inner rings, the polygon itself is ring `rings`.
+    let mut previous: Vec<u32> = Vec::new();
+    for l in 1..=rings {
+        let ring: Vec<u32> = if l == rings {
+            polygon.to_vec()
+        } else {
+            dirs.iter().map(|&d| new_column(slerp(centre_dir, d, l as f64 / rings as f64), out)).collect()
+        };
+        let n = ring.len();
+        for i in 0..n {
+            let j = (i + 1) % n;
+            let face = if l == 1 {
+                FanFace::new(&[centre, ring[i], ring[j]], patch)
+            } else {
+                FanFace::new(&[previous[j], previous[i], ring[i], ring[j]], patch)
+            };
+            out.fan_faces.push(face);
+        }
+        previous = ring;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::surface::shapes;
+
+    fn cube_normals(n: usize) -> (Surface, WallNormals) {
+        let s = shapes::cuboid(DVec3::ONE, n);
+        let topo = Topology::new(&s);
+        let features = Features::compute(&s, &topo, 30.0);
+        let normals = wall_normals(&s, &topo, &features, 20.0);
+        (s, normals)
+    }
+
+    /// Every fan face, lifted to distance 1 along its columns, faces away from the body
+    /// (its Newell normal agrees with its columns' mean direction).
+    #[test]
+    fn fan_faces_face_the_fluid() {
+        let (s, normals) = cube_normals(2);
+        for f in &normals.fan_faces {
+            let pts: Vec<DVec3> = f
+                .columns()
+                .iter()
+                .map(|&c| {
+                    let seed = normals.columns[c as usize];
+                    s.points[seed.vertex as usize] + seed.direction
+                })
+                .collect();
+            let mut newell = DVec3::ZERO;
+            for i in 0..pts.len() {
+                newell += pts[i].cross(pts[(i + 1) % pts.len()]);
+            }
+            let mean: DVec3 = f.columns().iter().map(|&c| normals.columns[c as usize].direction).sum();
+            assert!(newell.dot(mean) > 0.0, "fan face {:?} faces the body", f.columns());
+        }
+    }
+}

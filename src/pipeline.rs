@@ -1,0 +1,248 @@
+//! The `mesh` pipeline, stage by stage (DESIGN.md): validate, analyse features, normals,
+//! layers, (core), check; with timings and the run's report.
+
+use serde::Serialize;
+
+use crate::config::{Config, ConfigError, Flow, LayerCount, LayerSpec};
+use crate::layers::{self, MarchStats};
+use crate::mesh::{CellKind, VolumeMesh};
+use crate::normals::{self, NormalStats};
+use crate::progress::{Progress, Timings};
+use crate::quality::{self, CheckReport};
+use crate::surface::features::{FeatureCounts, Features};
+use crate::surface::topology::Topology;
+use crate::surface::validate::{validate, ValidationError, ValidationOptions};
+use crate::surface::Surface;
+
+/// Options of a run that are not meshing parameters.
+#[derive(Clone, Debug)]
+pub struct MeshOptions {
+    /// Fill the core with tetrahedra (not available yet: the layers are written alone).
+    pub core: bool,
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum MeshError {
+    #[error("invalid surface: {0}")]
+    Surface(#[from] ValidationError),
+    #[error(transparent)]
+    Config(#[from] ConfigError),
+    #[error("{0}")]
+    Unsupported(String),
+    #[error("the mesh failed its own check (a bug in blmesh; please report it):\n{0}")]
+    InvalidResult(Box<CheckReport>),
+}
+
+/// The mesh and its report.
+pub struct MeshOutput {
+    pub mesh: VolumeMesh,
+    pub report: MeshReport,
+}
+
+/// Everything the run measured; printed as a summary and written with `--report`.
+#[derive(Clone, Debug, Serialize)]
+pub struct MeshReport {
+    pub input: InputSummary,
+    pub features: FeatureCounts,
+    pub normals: NormalStats,
+    pub layers: LayerSummary,
+    pub core: &'static str,
+    pub cells: CellCounts,
+    pub check: CheckReport,
+    pub timings: Timings,
+    pub warnings: Vec<String>,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct InputSummary {
+    pub triangles: usize,
+    pub vertices: usize,
+    pub patches: Vec<String>,
+    pub body_size: f64,
+}
+
+#[derive(Clone, Debug, Serialize)]
+pub struct LayerSummary {
+    pub march: MarchStats,
+    /// Layers reached over the wall vertices that get layers: min, median, max.
+    pub layers_min: u32,
+    pub layers_median: u32,
+    pub layers_max: u32,
+    /// Fraction of layered wall vertices that reached their full stack.
+    pub full_coverage: f64,
+    /// Wall vertices whose column stopped before its target, with a few examples.
+    pub stopped_vertices: usize,
+    pub stopped_examples: Vec<[f64; 3]>,
+}
+
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CellCounts {
+    pub tetrahedra: usize,
+    pub pyramids: usize,
+    pub prisms: usize,
+    pub hexahedra: usize,
+    pub points: usize,
+}
+
+impl CellCounts {
+    fn of(mesh: &VolumeMesh) -> Self {
+        CellCounts {
+            tetrahedra: mesh.block(CellKind::Tetrahedron).len(),
+            pyramids: mesh.block(CellKind::Pyramid).len(),
+            prisms: mesh.block(CellKind::Prism).len(),
+            hexahedra: mesh.block(CellKind::Hexahedron).len(),
+            points: mesh.points.len(),
+        }
+    }
+}
+
+/// Run the whole pipeline on a surface.
+pub fn run(
+    mut surface: Surface,
+    config: &Config,
+    options: &MeshOptions,
+    progress: Progress,
+) -> Result<MeshOutput, MeshError> {
+    let mut timings = Timings::default();
+    let mut warnings = Vec::new();
+    let validation = timings.time("validate", || validate(&mut surface, &ValidationOptions::default()))?;
+    warnings.extend(validation.warnings.iter().cloned());
+    if config.flow == Flow::Internal {
+        // Layers grow into the fluid, which is inside the surface: face the normals inward.
+        surface.flip_all();
+    }
+    let body_size = surface.bounding_box().diagonal();
+    let patch_spec = patch_layer_specs(&surface, config, body_size)?;
+    let (topology, features) = timings.time("features", || {
+        let topology = Topology::new(&surface);
+        let features = Features::compute(&surface, &topology, config.feature_angle());
+        (topology, features)
+    });
+    let wall_normals =
+        timings.time("normals", || normals::wall_normals(&surface, &topology, &features, config.fan_angle()));
+    let bar = progress.bar(0, "layers");
+    let layered = timings.time("layers", || {
+        layers::build_layers(&surface, &wall_normals, &patch_spec, |k, n| {
+            bar.set_length(n as u64);
+            bar.set_position(k as u64);
+        })
+    });
+    bar.finish_and_clear();
+    let core = if options.core {
+        warnings.push("core fill is not implemented yet: the mesh holds the layers only".into());
+        "not built (not implemented yet)"
+    } else {
+        "not requested (--no-core)"
+    };
+    let check = timings.time("check", || quality::check(&layered.mesh));
+    if !check.is_valid() {
+        return Err(MeshError::InvalidResult(Box::new(check)));
+    }
+    let report = MeshReport {
+        input: InputSummary {
+            triangles: surface.triangles.len(),
+            vertices: surface.points.len(),
+            patches: surface.patch_names.clone(),
+            body_size,
+        },
+        features: features.counts.clone(),
+        normals: wall_normals.stats.clone(),
+        layers: layer_summary(&layered, &surface),
+        core,
+        cells: CellCounts::of(&layered.mesh),
+        check,
+        timings,
+        warnings,
+    };
+    Ok(MeshOutput { mesh: layered.mesh, report })
+}
+
+/// The resolved layer stack of every patch (`None`: no layers on it).
+fn patch_layer_specs(surface: &Surface, config: &Config, body_size: f64) -> Result<Vec<Option<LayerSpec>>, MeshError> {
+    surface
+        .patch_names
+        .iter()
+        .map(|name| {
+            let (role, settings) = config.patch_settings(name);
+            if !role.has_layers() {
+                return Ok(None);
+            }
+            let spec = LayerSpec::resolve(&settings, body_size)?;
+            if spec.count == LayerCount::Auto {
+                return Err(MeshError::Unsupported(format!(
+                    "patch {name}: count = \"auto\" needs the sizing field, which is not implemented yet"
+                )));
+            }
+            Ok(Some(spec))
+        })
+        .collect()
+}
+
+fn layer_summary(layered: &layers::Layers, surface: &Surface) -> LayerSummary {
+    let mut reached: Vec<u32> = layered.vertex_layers.iter().flatten().copied().collect();
+    reached.sort_unstable();
+    let full = layered
+        .vertex_layers
+        .iter()
+        .zip(&layered.vertex_target)
+        .filter(|(l, t)| matches!((l, t), (Some(l), Some(t)) if l >= t))
+        .count();
+    let pick = |i: usize| reached.get(i).copied().unwrap_or(0);
+    LayerSummary {
+        march: layered.stats.clone(),
+        layers_min: pick(0),
+        layers_median: pick(reached.len() / 2),
+        layers_max: reached.last().copied().unwrap_or(0),
+        full_coverage: if reached.is_empty() { 0.0 } else { full as f64 / reached.len() as f64 },
+        stopped_vertices: layered.stopped_vertices.len(),
+        stopped_examples: layered
+            .stopped_vertices
+            .iter()
+            .take(5)
+            .map(|&v| surface.points[v as usize].to_array())
+            .collect(),
+    }
+}
+
+impl std::fmt::Display for MeshReport {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let c = &self.cells;
+        let l = &self.layers;
+        writeln!(f, "input     {} triangles, {} vertices, {} patches", self.input.triangles, self.input.vertices, self.input.patches.len())?;
+        writeln!(
+            f,
+            "cells     {} prisms, {} pyramids, {} tetrahedra, {} hexahedra ({} points)",
+            c.prisms, c.pyramids, c.tetrahedra, c.hexahedra, c.points
+        )?;
+        writeln!(
+            f,
+            "layers    min {} / median {} / max {}; full stack at {:.2}% of wall vertices; {} stopped early",
+            l.layers_min,
+            l.layers_median,
+            l.layers_max,
+            100.0 * l.full_coverage,
+            l.stopped_vertices
+        )?;
+        writeln!(
+            f,
+            "normals   {} columns ({} in fans over {} convex ridge edges, {} corner patches)",
+            self.normals.columns, self.normals.fan_columns, self.normals.fan_edges, self.normals.corner_patches
+        )?;
+        writeln!(f, "core      {}", self.core)?;
+        writeln!(f, "quality   worst scaled Jacobian {:.3}", worst_scaled_jacobian(&self.check))?;
+        for w in &self.warnings {
+            writeln!(f, "warning   {w}")?;
+        }
+        write!(f, "time\n{}", self.timings)
+    }
+}
+
+/// The smallest scaled Jacobian over all cells.
+fn worst_scaled_jacobian(check: &CheckReport) -> f64 {
+    CellKind::ALL
+        .iter()
+        .map(|&k| check.quality.get(k))
+        .filter(|q| q.cells > 0)
+        .map(|q| q.scaled_jacobian.min)
+        .fold(f64::INFINITY, f64::min)
+}
