@@ -58,12 +58,14 @@ impl Proposal<'_> {
     fn cell_is_valid(&self, cell: &SlabCell) -> bool {
         match cell {
             SlabCell::Empty => true,
+            SlabCell::Flat => false,
             SlabCell::Standard { kind, nodes } => cell_validity(*kind, &self.gather(nodes)).is_valid(),
             SlabCell::Split { faces } => {
                 let centre = self.centre(faces);
                 split_pieces(faces, u32::MAX).all(|(kind, nodes)| {
-                    let mut x = self.gather(&nodes);
-                    x[nodes.len() - 1] = centre;
+                    let apex = nodes.len() - 1;
+                    let mut x = self.gather(&nodes[..apex]);
+                    x[apex] = centre;
                     cell_validity(kind, &x).is_valid()
                 })
             }
@@ -194,8 +196,12 @@ fn commit_slab(
     }
     for f in 0..front.len() {
         let (b, t, n) = face_nodes(front, f, &top, columns);
+        if b[..n] != t[..n] {
+            // The top is now front, even under a flat cell whose top lies on a neighbour's face.
+            front.raised[f] = true;
+        }
         match slab_cell(&b[..n], &t[..n]) {
-            SlabCell::Empty => continue,
+            SlabCell::Empty | SlabCell::Flat => {}
             SlabCell::Standard { kind, nodes } => mesh.push_cell(kind, &nodes, LAYER_ZONE),
             SlabCell::Split { faces } => {
                 let centre = mesh.points.len() as u32;
@@ -208,7 +214,6 @@ fn commit_slab(
                 stats.steiner_points += 1;
             }
         }
-        front.raised[f] = true;
     }
     columns.node = top;
 }

@@ -68,8 +68,12 @@ impl Polygon {
 /// What to emit for one slab cell.
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub enum SlabCell {
-    /// Nothing: every column of the face has stopped (or the cell is flat).
+    /// Nothing: every column of the face has stopped.
     Empty,
+    /// Some columns moved but the faces enclose no volume (e.g. a fan triangle at the wall with
+    /// one column stopped: its top lies on its own lateral face). Never emitted: the march
+    /// treats it as invalid and stops the face's other columns too.
+    Flat,
     /// One standard cell in Gmsh node order.
     Standard { kind: CellKind, nodes: Vec<u32> },
     /// A polyhedron to split from a new centre point: its outward faces.
@@ -101,7 +105,7 @@ pub fn slab_cell(bottom: &[u32], top: &[u32]) -> SlabCell {
     distinct.sort_unstable();
     distinct.dedup();
     if faces.len() < 4 || distinct.len() < 4 {
-        return SlabCell::Empty;
+        return SlabCell::Flat;
     }
     let quads = faces.iter().filter(|f| f.is_quad()).count();
     let tris = faces.len() - quads;

@@ -18,6 +18,7 @@
 use glam::DVec3;
 
 use super::most_normal::most_normal;
+use crate::layers::slab::Polygon;
 use crate::surface::features::{EdgeKind, Features};
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
@@ -330,7 +331,11 @@ fn strips(
         let patch = surface.triangle_patch[t1 as usize];
         let (vc, wc) = (&fans.at[i][0], &fans.at[i][1]);
         for j in 0..segments[i] as usize {
-            out.fan_faces.push(FanFace::new(&[wc[j], vc[j], vc[j + 1], wc[j + 1]], patch));
+            let quad = [wc[j], vc[j], vc[j + 1], wc[j + 1]];
+            // A ridge ending at both ends (a single fan column each) needs no strip.
+            if let Some(face) = Polygon::dedup(&quad) {
+                out.fan_faces.push(FanFace::new(face.nodes(), patch));
+            }
         }
     }
 }
@@ -438,6 +443,52 @@ mod tests {
             }
             let mean: DVec3 = f.columns().iter().map(|&c| normals.columns[c as usize].direction).sum();
             assert!(newell.dot(mean) > 0.0, "fan face {:?} faces the body", f.columns());
+        }
+    }
+}
+
+#[cfg(test)]
+mod closed_front_tests {
+    use super::*;
+    use std::collections::HashMap;
+
+    /// Directed column edges of the initial front that have no opposite twin.
+    pub(crate) fn unmatched_edges(normals: &WallNormals) -> Vec<(u32, u32)> {
+        let mut count: HashMap<(u32, u32), i32> = HashMap::new();
+        let faces = normals.triangle_columns.iter().map(|t| t.as_slice()).chain(normals.fan_faces.iter().map(|f| f.columns()));
+        for cols in faces {
+            for i in 0..cols.len() {
+                let (a, b) = (cols[i], cols[(i + 1) % cols.len()]);
+                if a != b {
+                    *count.entry((a, b)).or_default() += 1;
+                }
+            }
+        }
+        let mut bad: Vec<(u32, u32)> =
+            count.iter().filter(|(&(a, b), &n)| n != 1 || count.get(&(b, a)) != Some(&1)).map(|(&e, _)| e).collect();
+        bad.sort_unstable();
+        bad
+    }
+
+    #[test]
+    fn initial_front_is_closed_on_real_geometries() {
+        for name in ["building_wtc2.obj", "spot.obj", "cutcube_cfmesh.stl", "fandisk.obj", "flange.stl", "arrow_cape.stl"] {
+            let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
+            let s = crate::io::read_surface(std::path::Path::new(&path)).unwrap();
+            let topo = Topology::new(&s);
+            let features = Features::compute(&s, &topo, 30.0);
+            let normals = wall_normals(&s, &topo, &features, 20.0);
+            let bad = unmatched_edges(&normals);
+            let show: Vec<String> = bad
+                .iter()
+                .take(6)
+                .map(|&(a, b)| {
+                    let (va, vb) = (normals.columns[a as usize].vertex, normals.columns[b as usize].vertex);
+                    let kinds = (features.vertex_kind[va as usize], features.vertex_kind[vb as usize]);
+                    format!("({a},{b}) at vertices ({va},{vb}) {kinds:?}")
+                })
+                .collect();
+            assert!(bad.is_empty(), "{name}: {} unmatched front edges: {}", bad.len(), show.join("; "));
         }
     }
 }
