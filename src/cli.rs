@@ -14,7 +14,7 @@ use crate::io::{self, MeshFormat};
 use crate::pipeline::{self, MeshOptions};
 use crate::progress::Progress;
 use crate::quality;
-use crate::surface::info::SurfaceInfo;
+use crate::surface::info::{SurfaceInfo, ValidationSummary};
 
 /// Exit code for invalid input or a failed run (clap itself uses 2 for bad usage).
 const EXIT_FAILURE: u8 = 1;
@@ -67,22 +67,22 @@ struct MeshArgs {
     #[arg(long)]
     config: Option<PathBuf>,
     /// First layer height h0 (surface units).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     first_height: Option<f64>,
     /// Growth ratio r (layer k is h0 r^k high).
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     growth: Option<f64>,
     /// Number of layers, or "auto" to stop where cells become isotropic.
     #[arg(long)]
     layers: Option<LayerCount>,
     /// Total layer thickness (instead of --layers).
-    #[arg(long, conflicts_with = "layers")]
+    #[arg(long, conflicts_with = "layers", allow_negative_numbers = true)]
     thickness: Option<f64>,
     /// Edges turning more than this (degrees) are ridges.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     feature_angle: Option<f64>,
     /// Largest angle (degrees) between neighbouring normals of a fan at a convex ridge.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     fan_angle: Option<f64>,
     /// Write only the layers (no core tetrahedra).
     #[arg(long)]
@@ -142,8 +142,11 @@ fn info(path: &Path, json: bool, feature_angle: f64) -> Result<ExitCode> {
     } else {
         println!("{}\n{info}", path.display());
     }
-    let valid = matches!(info.validation, crate::surface::info::ValidationSummary::Valid { .. });
-    Ok(if valid { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
+    if let ValidationSummary::Invalid { error } = &info.validation {
+        eprintln!("error: {}: invalid surface: {error}", path.display());
+        return Ok(ExitCode::from(EXIT_FAILURE));
+    }
+    Ok(ExitCode::SUCCESS)
 }
 
 fn check(path: &Path, json: bool) -> Result<ExitCode> {
