@@ -7,7 +7,7 @@ cd "$(dirname "$0")/.."
 
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-APT_PACKAGES="python3-venv libglu1-mesa libxcursor1 libxft2 libxinerama1 libxrender1 libxext6 libfontconfig1"
+APT_PACKAGES="python3-venv libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libfontconfig1 libfreetype6 libgomp1"
 missing=""
 for p in $APT_PACKAGES; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"

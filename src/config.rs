@@ -180,8 +180,7 @@ impl Config {
     pub fn from_toml_file(path: &Path) -> Result<Config, ConfigError> {
         let text = std::fs::read_to_string(path)
             .map_err(|source| ConfigError::Io { path: path.to_owned(), source })?;
-        Self::from_toml_str(&text)
-            .map_err(|message| ConfigError::Syntax { path: path.to_owned(), message })
+        Self::from_toml_str(&text).map_err(|message| ConfigError::Syntax { path: path.to_owned(), message })
     }
 
     pub fn from_toml_str(text: &str) -> Result<Config, String> {
@@ -208,10 +207,8 @@ impl Config {
         }
         validate_layer_settings("layers", &self.layers)?;
         for rule in &self.patches {
-            regex::Regex::new(&rule.pattern).map_err(|e| ConfigError::Pattern {
-                pattern: rule.pattern.clone(),
-                why: e.to_string(),
-            })?;
+            regex::Regex::new(&rule.pattern)
+                .map_err(|e| ConfigError::Pattern { pattern: rule.pattern.clone(), why: e.to_string() })?;
             validate_layer_settings(&format!("patch {:?}", rule.pattern), &rule.layers)?;
         }
         Ok(())
@@ -373,7 +370,8 @@ mod tests {
 
     #[test]
     fn thickness_gives_the_fewest_layers_reaching_it() {
-        let s = LayerSettings { first_height: Some(1.0), growth: Some(2.0), thickness: Some(7.0), count: None };
+        let s =
+            LayerSettings { first_height: Some(1.0), growth: Some(2.0), thickness: Some(7.0), count: None };
         let spec = LayerSpec::resolve(&s, 1.0).unwrap();
         assert_eq!(spec.count, LayerCount::Fixed(3)); // 1 + 2 + 4 = 7
         assert_eq!(spec.distance(3), 7.0);

@@ -158,7 +158,11 @@ pub fn run(
 }
 
 /// The resolved layer stack of every patch (`None`: no layers on it).
-fn patch_layer_specs(surface: &Surface, config: &Config, body_size: f64) -> Result<Vec<Option<LayerSpec>>, MeshError> {
+fn patch_layer_specs(
+    surface: &Surface,
+    config: &Config,
+    body_size: f64,
+) -> Result<Vec<Option<LayerSpec>>, MeshError> {
     surface
         .patch_names
         .iter()
@@ -208,7 +212,13 @@ impl std::fmt::Display for MeshReport {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
         let c = &self.cells;
         let l = &self.layers;
-        writeln!(f, "input     {} triangles, {} vertices, {} patches", self.input.triangles, self.input.vertices, self.input.patches.len())?;
+        writeln!(
+            f,
+            "input     {} triangles, {} vertices, {} patches",
+            self.input.triangles,
+            self.input.vertices,
+            self.input.patches.len()
+        )?;
         writeln!(
             f,
             "cells     {} prisms, {} pyramids, {} tetrahedra, {} hexahedra ({} points)",
@@ -226,7 +236,10 @@ impl std::fmt::Display for MeshReport {
         writeln!(
             f,
             "normals   {} columns ({} in fans over {} convex ridge edges, {} corner patches)",
-            self.normals.columns, self.normals.fan_columns, self.normals.fan_edges, self.normals.corner_patches
+            self.normals.columns,
+            self.normals.fan_columns,
+            self.normals.fan_edges,
+            self.normals.corner_patches
         )?;
         writeln!(f, "core      {}", self.core)?;
         writeln!(f, "quality   worst scaled Jacobian {:.3}", worst_scaled_jacobian(&self.check))?;

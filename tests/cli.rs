@@ -33,10 +33,21 @@ fn geometry(name: &str) -> String {
 
 /// A unit cube as OBJ text, with `edit` applied to its 12 faces first.
 fn cube_obj(edit: impl FnOnce(&mut Vec<[usize; 3]>, &mut Vec<[f64; 3]>)) -> String {
-    let mut v: Vec<[f64; 3]> = (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
+    let mut v: Vec<[f64; 3]> =
+        (0..8).map(|i| [(i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64]).collect();
     let mut f: Vec<[usize; 3]> = vec![
-        [0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4],
-        [2, 6, 7], [2, 7, 3], [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5],
+        [0, 2, 3],
+        [0, 3, 1],
+        [4, 5, 7],
+        [4, 7, 6],
+        [0, 1, 5],
+        [0, 5, 4],
+        [2, 6, 7],
+        [2, 7, 3],
+        [0, 4, 6],
+        [0, 6, 2],
+        [1, 3, 7],
+        [1, 7, 5],
     ];
     edit(&mut f, &mut v);
     let mut s = String::new();
@@ -60,7 +71,14 @@ fn bad_inputs() -> Vec<Case> {
     truncated_stl.extend(12u32.to_le_bytes());
     truncated_stl.extend(vec![0u8; 50 * 3 + 7]);
     vec![
-        Case { file: "open.obj", bytes: cube_obj(|f, _| { f.pop(); }).into(), words: &["open", "edge"] },
+        Case {
+            file: "open.obj",
+            bytes: cube_obj(|f, _| {
+                f.pop();
+            })
+            .into(),
+            words: &["open", "edge"],
+        },
         Case {
             file: "nonmanifold.obj",
             // A tetrahedron hanging on the cube's edge (0, 1): four triangles on that edge.
@@ -90,19 +108,32 @@ fn bad_inputs() -> Vec<Case> {
                 let mut s = a.clone();
                 s += &b.lines().filter(|l| l.starts_with('v')).map(|l| format!("{l}\n")).collect::<String>();
                 for l in b.lines().filter(|l| l.starts_with('f')) {
-                    let ids: Vec<usize> = l[2..].split(' ').map(|x| x.parse::<usize>().unwrap() + 8).collect();
+                    let ids: Vec<usize> =
+                        l[2..].split(' ').map(|x| x.parse::<usize>().unwrap() + 8).collect();
                     s += &format!("f {} {} {}\n", ids[0], ids[1], ids[2]);
                 }
                 s.into()
             },
             words: &["intersect"],
         },
-        Case { file: "nan.obj", bytes: cube_obj(|_, v| v[3][1] = f64::NAN).into(), words: &["finite", "vertex 3"] },
+        Case {
+            file: "nan.obj",
+            bytes: cube_obj(|_, v| v[3][1] = f64::NAN).into(),
+            words: &["finite", "vertex 3"],
+        },
         Case { file: "truncated.stl", bytes: truncated_stl, words: &["truncated.stl"] },
         Case { file: "empty.stl", bytes: Vec::new(), words: &["empty.stl"] },
         Case { file: "empty.msh", bytes: Vec::new(), words: &["empty.msh"] },
-        Case { file: "garbage.off", bytes: (0..4096u32).map(|i| (i.wrapping_mul(2654435761) >> 13) as u8).collect(), words: &["garbage.off"] },
-        Case { file: "garbage.obj", bytes: b"\x7fELF\x02\x01\x01\0\0\0\xff\xfe garbage".to_vec(), words: &["garbage.obj", "line 1"] },
+        Case {
+            file: "garbage.off",
+            bytes: (0..4096u32).map(|i| (i.wrapping_mul(2654435761) >> 13) as u8).collect(),
+            words: &["garbage.off"],
+        },
+        Case {
+            file: "garbage.obj",
+            bytes: b"\x7fELF\x02\x01\x01\0\0\0\xff\xfe garbage".to_vec(),
+            words: &["garbage.obj", "line 1"],
+        },
     ]
 }
 
@@ -120,7 +151,10 @@ fn bad_surfaces_give_clear_errors_and_no_output() {
         assert!(!out.exists(), "{}: a failed run left an output file", case.file);
     }
     let leftovers: Vec<PathBuf> = std::fs::read_dir(dir.path()).unwrap().map(|e| e.unwrap().path()).collect();
-    assert!(leftovers.iter().all(|p| !p.file_name().unwrap().to_string_lossy().starts_with(".blmesh")), "temporaries left: {leftovers:?}");
+    assert!(
+        leftovers.iter().all(|p| !p.file_name().unwrap().to_string_lossy().starts_with(".blmesh")),
+        "temporaries left: {leftovers:?}"
+    );
 }
 
 #[test]
@@ -143,7 +177,10 @@ fn impossible_parameters_are_refused() {
         assert_fails_with(&blmesh(&all), words);
         assert!(!out.exists());
     }
-    assert_fails_with(&blmesh(&["mesh", c, "-o", dir.path().join("out.xyz").to_str().unwrap()]), &["out.xyz", "format"]);
+    assert_fails_with(
+        &blmesh(&["mesh", c, "-o", dir.path().join("out.xyz").to_str().unwrap()]),
+        &["out.xyz", "format"],
+    );
 }
 
 /// Write `mesh` to `dir/name` and run `blmesh check` on it.
@@ -190,13 +227,28 @@ fn mesh_runs_end_to_end_on_every_shared_surface() {
     let dir = tempfile::tempdir().unwrap();
     let mut rows = Vec::new();
     for name in [
-        "cutcube_cfmesh.stl", "mech_test_gapdetection.obj", "building_wtc2.obj", "spot.obj", "fandisk.obj",
-        "flange.stl", "arrow_cape.uh3d", "elbow_90degree_cfmesh.stl", "bunny_closed_herholz.off",
+        "cutcube_cfmesh.stl",
+        "mech_test_gapdetection.obj",
+        "building_wtc2.obj",
+        "spot.obj",
+        "fandisk.obj",
+        "flange.stl",
+        "arrow_cape.uh3d",
+        "elbow_90degree_cfmesh.stl",
+        "bunny_closed_herholz.off",
         "onera_m6_gmsh_coarse.stl",
     ] {
         let out = dir.path().join(format!("{name}.msh"));
         let report = dir.path().join(format!("{name}.json"));
-        let o = blmesh(&["mesh", &geometry(name), "-o", out.to_str().unwrap(), "--report", report.to_str().unwrap(), "-q"]);
+        let o = blmesh(&[
+            "mesh",
+            &geometry(name),
+            "-o",
+            out.to_str().unwrap(),
+            "--report",
+            report.to_str().unwrap(),
+            "-q",
+        ]);
         assert_eq!(o.status.code(), Some(0), "{name}: {}", stderr(&o));
         let check = blmesh(&["check", out.to_str().unwrap()]);
         assert_eq!(check.status.code(), Some(0), "{name}: {}", String::from_utf8_lossy(&check.stdout));

@@ -52,7 +52,9 @@ fn top_nodes(mesh: &VolumeMesh) -> Vec<u32> {
         .zip(&b.triangle_patch)
         .filter(|(_, &p)| p == top)
         .flat_map(|(t, _)| t.iter().copied())
-        .chain(b.quads.iter().zip(&b.quad_patch).filter(|(_, &p)| p == top).flat_map(|(q, _)| q.iter().copied()))
+        .chain(
+            b.quads.iter().zip(&b.quad_patch).filter(|(_, &p)| p == top).flat_map(|(q, _)| q.iter().copied()),
+        )
         .collect();
     nodes.sort_unstable();
     nodes.dedup();
@@ -87,7 +89,8 @@ fn box_gets_all_layers_with_fans_on_the_exact_offset() {
     // sphere octants). Fans are chords of the cylinders and spheres: with steps of at most
     // 20 degrees they miss at most 1 - sin(20)/20deg = 2% of those curved parts' volume.
     let exact_faces = 2.0 * (a * b + b * c + c * a) * t;
-    let exact_curved = std::f64::consts::PI * (a + b + c) * t * t + 4.0 / 3.0 * std::f64::consts::PI * t.powi(3);
+    let exact_curved =
+        std::f64::consts::PI * (a + b + c) * t * t + 4.0 / 3.0 * std::f64::consts::PI * t.powi(3);
     let v = out.report.check.volume.cells;
     let missing = exact_faces + exact_curved - v;
     assert!(missing >= -1e-12 * v, "more than the exact offset volume: {v}");
@@ -104,7 +107,8 @@ fn sphere_gets_all_layers_on_the_exact_offset() {
     // Volume identity: prisms over the polyhedral wall with every column at distance t from its
     // incident faces. On a sphere of radius R the shell volume is area * t * (1 + t/R + t^2/3R^2);
     // the polyhedral wall (edge turns ~9 degrees) may differ from that by at most 1%.
-    let area: f64 = (0..surface.triangles.len()).map(|i| surface.triangle_area_vector(i).length() / 2.0).sum();
+    let area: f64 =
+        (0..surface.triangles.len()).map(|i| surface.triangle_area_vector(i).length() / 2.0).sum();
     let v = out.report.check.volume.cells;
     let sphere_shell = area * t * (1.0 + t + t * t / 3.0);
     assert!((v / sphere_shell - 1.0).abs() < 0.01, "shell volume {v} vs {sphere_shell}");

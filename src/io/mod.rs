@@ -125,10 +125,8 @@ fn read_bytes(path: &Path) -> Result<Vec<u8>, ReadError> {
 
 /// Read a triangle surface with patch names; the format is chosen by the file extension.
 pub fn read_surface(path: &Path) -> Result<Surface, ReadError> {
-    let format = SurfaceFormat::from_path(path).ok_or_else(|| ReadError::UnknownFormat {
-        path: path.to_owned(),
-        expected: SURFACE_EXTENSIONS,
-    })?;
+    let format = SurfaceFormat::from_path(path)
+        .ok_or_else(|| ReadError::UnknownFormat { path: path.to_owned(), expected: SURFACE_EXTENSIONS })?;
     let bytes = read_bytes(path)?;
     format.parse(&bytes).map_err(|source| ReadError::Parse { path: path.to_owned(), source })
 }
@@ -139,9 +137,7 @@ pub fn read_volume_mesh(path: &Path) -> Result<VolumeMesh, ReadError> {
     let parse: fn(&[u8]) -> Result<VolumeMesh, ParseError> = match ext.as_deref() {
         Some("msh") => msh::parse_volume,
         Some("vtu") => vtu::parse,
-        _ => {
-            return Err(ReadError::UnknownFormat { path: path.to_owned(), expected: ".msh, .vtu" })
-        }
+        _ => return Err(ReadError::UnknownFormat { path: path.to_owned(), expected: ".msh, .vtu" }),
     };
     let bytes = read_bytes(path)?;
     parse(&bytes).map_err(|source| ReadError::Parse { path: path.to_owned(), source })
@@ -151,7 +147,9 @@ pub fn read_volume_mesh(path: &Path) -> Result<VolumeMesh, ReadError> {
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum MeshFormat {
     /// Gmsh MSH 4.1 (binary unless `ascii`).
-    Msh { ascii: bool },
+    Msh {
+        ascii: bool,
+    },
     Vtu,
 }
 

@@ -98,7 +98,8 @@ impl Front {
         let mut faces: Vec<usize> = columns
             .iter()
             .flat_map(|&c| {
-                let (lo, hi) = (self.column_face_offsets[c as usize], self.column_face_offsets[c as usize + 1]);
+                let (lo, hi) =
+                    (self.column_face_offsets[c as usize], self.column_face_offsets[c as usize + 1]);
                 self.column_faces[lo as usize..hi as usize].iter().map(|&f| f as usize)
             })
             .collect();

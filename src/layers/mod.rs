@@ -54,10 +54,10 @@ pub fn build_layers(
         zone_names: vec![LAYER_ZONE_NAME.to_owned()],
         ..Default::default()
     };
-    let distance = |c: usize, k: u32| column_spec[c].filter(|_| k <= target(c).unwrap_or(0)).map(|s| s.distance(k));
-    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, distance, |k| {
-        on_layer(k, max_layers)
-    });
+    let distance =
+        |c: usize, k: u32| column_spec[c].filter(|_| k <= target(c).unwrap_or(0)).map(|s| s.distance(k));
+    let stats =
+        march::march(&mut mesh, &mut columns, &mut front, max_layers, distance, |k| on_layer(k, max_layers));
     add_boundary(&mut mesh, surface, &front, &columns);
     let mut vertex_layers: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut vertex_target: Vec<Option<u32>> = vec![None; surface.points.len()];

@@ -140,21 +140,20 @@ fn pyramid(faces: &[Polygon], distinct: &[u32]) -> Option<(CellKind, Vec<u32>)> 
 /// the bottom nodes along the lateral quads' edges.
 fn extruded(faces: &[Polygon], end_len: usize, kind: CellKind) -> Option<(CellKind, Vec<u32>)> {
     let bottom_end = faces.iter().find(|f| f.len as usize == end_len)?;
-    let top_end = faces.iter().find(|f| {
-        f.len as usize == end_len && f.nodes().iter().all(|&n| !bottom_end.contains(n))
-    })?;
+    let top_end = faces
+        .iter()
+        .find(|f| f.len as usize == end_len && f.nodes().iter().all(|&n| !bottom_end.contains(n)))?;
     let bottom = bottom_end.reversed();
     let mut nodes = bottom.nodes().to_vec();
     for &b in bottom.nodes() {
-        let partner = faces
-            .iter()
-            .filter(|f| f.is_quad() && f.contains(b))
-            .flat_map(|f| f.edges())
-            .find_map(|(x, y)| match (x == b, y == b) {
-                (true, false) if top_end.contains(y) => Some(y),
-                (false, true) if top_end.contains(x) => Some(x),
-                _ => None,
-            })?;
+        let partner =
+            faces.iter().filter(|f| f.is_quad() && f.contains(b)).flat_map(|f| f.edges()).find_map(
+                |(x, y)| match (x == b, y == b) {
+                    (true, false) if top_end.contains(y) => Some(y),
+                    (false, true) if top_end.contains(x) => Some(x),
+                    _ => None,
+                },
+            )?;
         nodes.push(partner);
     }
     let mut tops = nodes[end_len..].to_vec();
@@ -230,7 +229,11 @@ mod tests {
     #[test]
     fn fan_corner_triangle_gives_a_tetrahedron() {
         let (kind, nodes) = standard(&[0, 0, 0], &[1, 2, 3]);
-        assert_eq!((kind, nodes), (CellKind::Tetrahedron, vec![3, 2, 1, 0]), "top reversed, wall node as apex");
+        assert_eq!(
+            (kind, nodes),
+            (CellKind::Tetrahedron, vec![3, 2, 1, 0]),
+            "top reversed, wall node as apex"
+        );
     }
 
     #[test]

@@ -98,12 +98,15 @@ fn vertex_ring(surface: &Surface, topology: &Topology, v: u32) -> Ring {
 }
 
 /// Build the columns and fan faces of the wall.
-pub fn wall_normals(surface: &Surface, topology: &Topology, features: &Features, fan_angle_deg: f64) -> WallNormals {
+pub fn wall_normals(
+    surface: &Surface,
+    topology: &Topology,
+    features: &Features,
+    fan_angle_deg: f64,
+) -> WallNormals {
     let fan_angle = fan_angle_deg.to_radians();
-    let mut out = WallNormals {
-        triangle_columns: vec![[u32::MAX; 3]; surface.triangles.len()],
-        ..Default::default()
-    };
+    let mut out =
+        WallNormals { triangle_columns: vec![[u32::MAX; 3]; surface.triangles.len()], ..Default::default() };
     let is_fan_edge = |e: u32| features.edge_kind[e as usize] == EdgeKind::ConvexRidge;
     // Per (vertex, fan edge): the sector columns on the edge's t1 side (index 0) and t2 side.
     let mut fan_ends: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); surface.points.len()];
@@ -156,7 +159,11 @@ fn sector_columns(
             // The triangle after e in the ring uses e as v -> other, so it is t1 (which runs
             // from edges[e][0] to edges[e][1]) when v is the edge's first vertex.
             let (after, before) = (sector_col_of_ring[(i + 1) % n], sector_col_of_ring[i]);
-            ends.push(if topology.edges[e as usize][0] == v { (e, after, before) } else { (e, before, after) });
+            ends.push(if topology.edges[e as usize][0] == v {
+                (e, after, before)
+            } else {
+                (e, before, after)
+            });
         }
     }
 }
@@ -275,7 +282,9 @@ fn fan_columns(
                     match (cols.first(), cols.last()) {
                         _ if cols.len() != m + 1 => None,
                         (Some(&x), Some(&y)) if (x, y) == (a, b) => Some(cols.clone()),
-                        (Some(&x), Some(&y)) if (x, y) == (b, a) => Some(cols.iter().rev().copied().collect()),
+                        (Some(&x), Some(&y)) if (x, y) == (b, a) => {
+                            Some(cols.iter().rev().copied().collect())
+                        }
                         _ => None,
                     }
                 });
@@ -379,7 +388,8 @@ fn corner_patches(
 /// columns around its most normal direction, `fan_angle` apart at most along the spokes.
 fn web_patch(v: u32, polygon: &[u32], patch: u32, fan_angle: f64, out: &mut WallNormals) {
     let dirs: Vec<DVec3> = polygon.iter().map(|&c| out.columns[c as usize].direction).collect();
-    let centre_dir = most_normal(&dirs).map_or_else(|| dirs.iter().sum::<DVec3>().normalize(), |m| m.direction);
+    let centre_dir =
+        most_normal(&dirs).map_or_else(|| dirs.iter().sum::<DVec3>().normalize(), |m| m.direction);
     let spoke = dirs.iter().map(|d| d.angle_between(centre_dir)).fold(0.0, f64::max);
     let rings = ((spoke / fan_angle).ceil() as usize).max(1);
     let new_column = |direction: DVec3, out: &mut WallNormals| {
@@ -455,7 +465,11 @@ mod closed_front_tests {
     /// Directed column edges of the initial front that have no opposite twin.
     pub(crate) fn unmatched_edges(normals: &WallNormals) -> Vec<(u32, u32)> {
         let mut count: HashMap<(u32, u32), i32> = HashMap::new();
-        let faces = normals.triangle_columns.iter().map(|t| t.as_slice()).chain(normals.fan_faces.iter().map(|f| f.columns()));
+        let faces = normals
+            .triangle_columns
+            .iter()
+            .map(|t| t.as_slice())
+            .chain(normals.fan_faces.iter().map(|f| f.columns()));
         for cols in faces {
             for i in 0..cols.len() {
                 let (a, b) = (cols[i], cols[(i + 1) % cols.len()]);
@@ -464,15 +478,25 @@ mod closed_front_tests {
                 }
             }
         }
-        let mut bad: Vec<(u32, u32)> =
-            count.iter().filter(|(&(a, b), &n)| n != 1 || count.get(&(b, a)) != Some(&1)).map(|(&e, _)| e).collect();
+        let mut bad: Vec<(u32, u32)> = count
+            .iter()
+            .filter(|(&(a, b), &n)| n != 1 || count.get(&(b, a)) != Some(&1))
+            .map(|(&e, _)| e)
+            .collect();
         bad.sort_unstable();
         bad
     }
 
     #[test]
     fn initial_front_is_closed_on_real_geometries() {
-        for name in ["building_wtc2.obj", "spot.obj", "cutcube_cfmesh.stl", "fandisk.obj", "flange.stl", "arrow_cape.stl"] {
+        for name in [
+            "building_wtc2.obj",
+            "spot.obj",
+            "cutcube_cfmesh.stl",
+            "fandisk.obj",
+            "flange.stl",
+            "arrow_cape.stl",
+        ] {
             let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
             let s = crate::io::read_surface(std::path::Path::new(&path)).unwrap();
             let topo = Topology::new(&s);

@@ -11,7 +11,12 @@ use super::Surface;
 /// The surface of a union of unit voxels of a grid, scaled by `cell` and subdivided `n` times
 /// along each voxel edge; `filled(i, j, k)` says which voxels are solid. Each of the six face
 /// directions is its own patch (`xmin`, `xmax`, `ymin`, `ymax`, `zmin`, `zmax`).
-pub fn voxels(dims: [usize; 3], cell: f64, n: usize, filled: impl Fn(usize, usize, usize) -> bool) -> Surface {
+pub fn voxels(
+    dims: [usize; 3],
+    cell: f64,
+    n: usize,
+    filled: impl Fn(usize, usize, usize) -> bool,
+) -> Surface {
     let inside = |i: i64, j: i64, k: i64| {
         i >= 0
             && j >= 0
@@ -23,8 +28,11 @@ pub fn voxels(dims: [usize; 3], cell: f64, n: usize, filled: impl Fn(usize, usiz
     };
     let mut builder = GridBuilder::new(cell / n as f64);
     let names = ["xmin", "xmax", "ymin", "ymax", "zmin", "zmax"];
-    let mut surface = Surface { patch_names: names.iter().map(|s| s.to_string()).collect(), ..Default::default() };
-    for (i, j, k) in (0..dims[0]).flat_map(|i| (0..dims[1]).flat_map(move |j| (0..dims[2]).map(move |k| (i, j, k)))) {
+    let mut surface =
+        Surface { patch_names: names.iter().map(|s| s.to_string()).collect(), ..Default::default() };
+    for (i, j, k) in
+        (0..dims[0]).flat_map(|i| (0..dims[1]).flat_map(move |j| (0..dims[2]).map(move |k| (i, j, k))))
+    {
         if !filled(i, j, k) {
             continue;
         }
@@ -87,7 +95,11 @@ impl GridBuilder {
                 };
                 let q = [corner(0, 0), corner(1, 0), corner(1, 1), corner(0, 1)].map(|g| self.point(g));
                 // (u, w, axis) is right-handed: u x w points along +axis.
-                let tris = if side == 1 { [[q[0], q[1], q[2]], [q[0], q[2], q[3]]] } else { [[q[0], q[2], q[1]], [q[0], q[3], q[2]]] };
+                let tris = if side == 1 {
+                    [[q[0], q[1], q[2]], [q[0], q[2], q[3]]]
+                } else {
+                    [[q[0], q[2], q[1]], [q[0], q[3], q[2]]]
+                };
                 for t in tris {
                     s.triangles.push(t);
                     s.triangle_patch.push(patch);
@@ -101,17 +113,43 @@ impl GridBuilder {
 pub fn icosphere(r: f64, level: usize) -> Surface {
     let t = (1.0 + 5f64.sqrt()) / 2.0;
     let mut points: Vec<DVec3> = [
-        [-1.0, t, 0.0], [1.0, t, 0.0], [-1.0, -t, 0.0], [1.0, -t, 0.0],
-        [0.0, -1.0, t], [0.0, 1.0, t], [0.0, -1.0, -t], [0.0, 1.0, -t],
-        [t, 0.0, -1.0], [t, 0.0, 1.0], [-t, 0.0, -1.0], [-t, 0.0, 1.0],
+        [-1.0, t, 0.0],
+        [1.0, t, 0.0],
+        [-1.0, -t, 0.0],
+        [1.0, -t, 0.0],
+        [0.0, -1.0, t],
+        [0.0, 1.0, t],
+        [0.0, -1.0, -t],
+        [0.0, 1.0, -t],
+        [t, 0.0, -1.0],
+        [t, 0.0, 1.0],
+        [-t, 0.0, -1.0],
+        [-t, 0.0, 1.0],
     ]
     .iter()
     .map(|p| DVec3::from_array(*p).normalize())
     .collect();
     let mut triangles: Vec<[u32; 3]> = vec![
-        [0, 11, 5], [0, 5, 1], [0, 1, 7], [0, 7, 10], [0, 10, 11], [1, 5, 9], [5, 11, 4], [11, 10, 2],
-        [10, 7, 6], [7, 1, 8], [3, 9, 4], [3, 4, 2], [3, 2, 6], [3, 6, 8], [3, 8, 9], [4, 9, 5],
-        [2, 4, 11], [6, 2, 10], [8, 6, 7], [9, 8, 1],
+        [0, 11, 5],
+        [0, 5, 1],
+        [0, 1, 7],
+        [0, 7, 10],
+        [0, 10, 11],
+        [1, 5, 9],
+        [5, 11, 4],
+        [11, 10, 2],
+        [10, 7, 6],
+        [7, 1, 8],
+        [3, 9, 4],
+        [3, 4, 2],
+        [3, 2, 6],
+        [3, 6, 8],
+        [3, 8, 9],
+        [4, 9, 5],
+        [2, 4, 11],
+        [6, 2, 10],
+        [8, 6, 7],
+        [9, 8, 1],
     ];
     for _ in 0..level {
         let mut midpoint: HashMap<(u32, u32), u32> = HashMap::new();
