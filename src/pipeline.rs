@@ -50,6 +50,8 @@ pub struct MeshReport {
     pub cells: CellCounts,
     pub check: CheckReport,
     pub timings: Timings,
+    /// Peak resident memory of the run, in MiB (Linux only).
+    pub peak_memory_mib: Option<f64>,
     pub warnings: Vec<String>,
 }
 
@@ -152,6 +154,7 @@ pub fn run(
         cells: CellCounts::of(&layered.mesh),
         check,
         timings,
+        peak_memory_mib: crate::progress::peak_memory_mib(),
         warnings,
     };
     Ok(MeshOutput { mesh: layered.mesh, report })
@@ -245,6 +248,9 @@ impl std::fmt::Display for MeshReport {
         writeln!(f, "quality   worst scaled Jacobian {:.3}", worst_scaled_jacobian(&self.check))?;
         for w in &self.warnings {
             writeln!(f, "warning   {w}")?;
+        }
+        if let Some(m) = self.peak_memory_mib {
+            writeln!(f, "memory    {m:.0} MiB peak")?;
         }
         write!(f, "time\n{}", self.timings)
     }

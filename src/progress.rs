@@ -67,3 +67,28 @@ impl std::fmt::Display for Timings {
         write!(f, "  {:<12} {:>9.3} s", "total", self.total())
     }
 }
+
+/// Peak resident memory of this process so far (Linux `VmHWM`), in MiB; `None` elsewhere.
+pub fn peak_memory_mib() -> Option<f64> {
+    let status = std::fs::read_to_string("/proc/self/status").ok()?;
+    let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
+    let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
+    Some(kib / 1024.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn timings_add_up_and_memory_is_read() {
+        let mut t = Timings::default();
+        let x = t.time("a", || 2 + 2);
+        assert_eq!(x, 4);
+        assert_eq!(t.stages.len(), 1);
+        assert!(t.total() >= 0.0);
+        if cfg!(target_os = "linux") {
+            assert!(peak_memory_mib().is_some_and(|m| m > 1.0));
+        }
+    }
+}

@@ -202,7 +202,9 @@ fn commit_slab(
         }
         match slab_cell(&b[..n], &t[..n]) {
             SlabCell::Empty | SlabCell::Flat => {}
-            SlabCell::Standard { kind, nodes } => mesh.push_cell(kind, &nodes, LAYER_ZONE),
+            SlabCell::Standard { kind, nodes } => {
+                mesh.push_cell(kind, &nodes[..kind.node_count()], LAYER_ZONE)
+            }
             SlabCell::Split { faces } => {
                 let centre = mesh.points.len() as u32;
                 let proposal = Proposal { points: &mesh.points, proposed: &[], committed: u32::MAX };

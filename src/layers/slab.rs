@@ -74,8 +74,8 @@ pub enum SlabCell {
     /// one column stopped: its top lies on its own lateral face). Never emitted: the march
     /// treats it as invalid and stops the face's other columns too.
     Flat,
-    /// One standard cell in Gmsh node order.
-    Standard { kind: CellKind, nodes: Vec<u32> },
+    /// One standard cell in Gmsh node order (the first `kind.node_count()` of `nodes`).
+    Standard { kind: CellKind, nodes: [u32; 8] },
     /// A polyhedron to split from a new centre point: its outward faces.
     Split { faces: Vec<Polygon> },
 }
@@ -100,6 +100,9 @@ pub fn slab_cell(bottom: &[u32], top: &[u32]) -> SlabCell {
     if bottom == top {
         return SlabCell::Empty;
     }
+    if let Some(cell) = intact_column_cell(bottom, top) {
+        return cell;
+    }
     let faces = slab_faces(bottom, top);
     let mut distinct: Vec<u32> = faces.iter().flat_map(|f| f.nodes().iter().copied()).collect();
     distinct.sort_unstable();
@@ -117,9 +120,31 @@ pub fn slab_cell(bottom: &[u32], top: &[u32]) -> SlabCell {
         _ => None,
     };
     match standard {
-        Some((kind, nodes)) => SlabCell::Standard { kind, nodes },
+        Some((kind, nodes)) => standard_cell(kind, &nodes),
         None => SlabCell::Split { faces },
     }
+}
+
+fn standard_cell(kind: CellKind, nodes: &[u32]) -> SlabCell {
+    let mut n = [0; 8];
+    n[..nodes.len()].copy_from_slice(nodes);
+    SlabCell::Standard { kind, nodes: n }
+}
+
+/// The common case without building faces: every column moves to a new node and the bottom
+/// has distinct nodes, so the cell is the prism (or hexahedron) over the face.
+fn intact_column_cell(bottom: &[u32], top: &[u32]) -> Option<SlabCell> {
+    let n = bottom.len();
+    let distinct = |x: &[u32]| (0..n).all(|i| (i + 1..n).all(|j| x[i] != x[j]));
+    let moved = (0..n).all(|i| !bottom.contains(&top[i]));
+    if !(moved && distinct(bottom) && distinct(top)) {
+        return None;
+    }
+    let kind = if n == 3 { CellKind::Prism } else { CellKind::Hexahedron };
+    let mut nodes = [0; 8];
+    nodes[..n].copy_from_slice(bottom);
+    nodes[n..2 * n].copy_from_slice(top);
+    Some(SlabCell::Standard { kind, nodes })
 }
 
 fn tetrahedron(faces: &[Polygon]) -> Option<(CellKind, Vec<u32>)> {
@@ -176,7 +201,7 @@ mod tests {
 
     fn standard(bottom: &[u32], top: &[u32]) -> (CellKind, Vec<u32>) {
         match slab_cell(bottom, top) {
-            SlabCell::Standard { kind, nodes } => (kind, nodes),
+            SlabCell::Standard { kind, nodes } => (kind, nodes[..kind.node_count()].to_vec()),
             other => panic!("expected a standard cell, got {other:?}"),
         }
     }
