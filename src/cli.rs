@@ -138,9 +138,9 @@ fn info(path: &Path, json: bool, feature_angle: f64) -> Result<ExitCode> {
     let surface = io::read_surface(path)?;
     let info = SurfaceInfo::compute(&surface, feature_angle);
     if json {
-        println!("{}", serde_json::to_string_pretty(&info)?);
+        print_out(&serde_json::to_string_pretty(&info)?);
     } else {
-        println!("{}\n{info}", path.display());
+        print_out(&format!("{}\n{info}", path.display()));
     }
     if let ValidationSummary::Invalid { error } = &info.validation {
         eprintln!("error: {}: invalid surface: {error}", path.display());
@@ -153,9 +153,9 @@ fn check(path: &Path, json: bool) -> Result<ExitCode> {
     let mesh = io::read_volume_mesh(path)?;
     let report = quality::check(&mesh);
     if json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        print_out(&serde_json::to_string_pretty(&report)?);
     } else {
-        println!("{}\n{report}", path.display());
+        print_out(&format!("{}\n{report}", path.display()));
     }
     Ok(if report.is_valid() { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
 }
@@ -176,7 +176,7 @@ fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
             .with_context(|| format!("{}: cannot write", report_path.display()))?;
     }
     if !quiet {
-        println!("{}", out.report);
+        print_out(&out.report.to_string());
     }
     Ok(ExitCode::SUCCESS)
 }
@@ -198,4 +198,11 @@ fn mesh_config(args: &MeshArgs) -> Result<Config> {
     config.fan_angle = args.fan_angle.or(config.fan_angle);
     config.validate()?;
     Ok(config)
+}
+
+/// Print to stdout; a closed pipe (`blmesh info x | head`) is not an error worth a panic.
+fn print_out(text: &str) {
+    use std::io::Write;
+    let mut out = std::io::stdout().lock();
+    let _ = writeln!(out, "{text}").and_then(|()| out.flush());
 }

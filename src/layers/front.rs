@@ -22,7 +22,12 @@ pub struct Columns {
     pub layers: Vec<u32>,
     /// The wall vertex the column grows from.
     pub wall_vertex: Vec<u32>,
+    /// The column this one merged into at a collapse ([`NOT_MERGED`] if none).
+    pub merged_into: Vec<u32>,
 }
+
+/// `Columns::merged_into` of a column that has not merged.
+pub const NOT_MERGED: u32 = u32::MAX;
 
 impl Columns {
     pub fn len(&self) -> usize {
@@ -31,6 +36,14 @@ impl Columns {
 
     pub fn is_empty(&self) -> bool {
         self.base.is_empty()
+    }
+
+    /// The column that carries `c` on: itself, or the last one of its chain of merges.
+    pub fn carrier(&self, mut c: usize) -> usize {
+        while self.merged_into[c] != NOT_MERGED {
+            c = self.merged_into[c] as usize;
+        }
+        c
     }
 }
 
@@ -41,8 +54,12 @@ pub struct Front {
     sizes: Vec<u8>,
     /// Input patch of every face (fan faces take the patch of a neighbouring triangle).
     pub patch: Vec<u32>,
-    /// The face has had a cell emitted under it: it is now a top face of the layers.
+    /// The face has moved off its first position: it is now a top face of the layers.
     pub raised: Vec<bool>,
+    /// The wall triangle a face started as (`u32::MAX` for fan faces).
+    pub wall_triangle: Vec<u32>,
+    /// Wall triangles that have had a cell built on them.
+    pub wall_raised: Vec<bool>,
     /// Faces around each column (CSR).
     column_face_offsets: Vec<u32>,
     column_faces: Vec<u32>,
@@ -57,13 +74,59 @@ impl Front {
         self.sizes.is_empty()
     }
 
-    pub fn push(&mut self, columns: &[u32], patch: u32) {
+    pub fn push(&mut self, columns: &[u32], patch: u32, wall_triangle: Option<u32>) {
         let mut c = [0; 4];
         c[..columns.len()].copy_from_slice(columns);
         self.columns.push(c);
         self.sizes.push(columns.len() as u8);
         self.patch.push(patch);
         self.raised.push(false);
+        self.wall_triangle.push(wall_triangle.unwrap_or(u32::MAX));
+        if let Some(t) = wall_triangle {
+            let t = t as usize;
+            if self.wall_raised.len() <= t {
+                self.wall_raised.resize(t + 1, false);
+            }
+        }
+    }
+
+    /// Mark face `f` as moved (and its wall triangle as covered by a cell).
+    pub fn raise(&mut self, f: usize) {
+        self.raised[f] = true;
+        if let Some(r) = self.wall_raised.get_mut(self.wall_triangle[f] as usize) {
+            *r = true;
+        }
+    }
+
+    /// Replace every column by `carrier[c]` after a slab with collapses, drop the faces that
+    /// have degenerated to an edge or a point, and rebuild the adjacency.
+    pub fn apply_merges(&mut self, carrier: &[u32]) {
+        let mut keep = 0;
+        for f in 0..self.len() {
+            let mapped: Vec<u32> = self.face_columns(f).iter().map(|&c| carrier[c as usize]).collect();
+            let Some(polygon) = crate::layers::slab::Polygon::dedup(&mapped) else { continue };
+            let nodes = polygon.nodes();
+            let mut c = [0; 4];
+            c[..nodes.len()].copy_from_slice(nodes);
+            self.columns[keep] = c;
+            self.sizes[keep] = nodes.len() as u8;
+            self.patch[keep] = self.patch[f];
+            self.raised[keep] = self.raised[f];
+            self.wall_triangle[keep] = self.wall_triangle[f];
+            keep += 1;
+        }
+        self.columns.truncate(keep);
+        self.sizes.truncate(keep);
+        self.patch.truncate(keep);
+        self.raised.truncate(keep);
+        self.wall_triangle.truncate(keep);
+        self.index_columns(carrier.len());
+    }
+
+    /// The faces around column `c`.
+    pub fn faces_of(&self, c: u32) -> impl Iterator<Item = usize> + '_ {
+        let (lo, hi) = (self.column_face_offsets[c as usize], self.column_face_offsets[c as usize + 1]);
+        self.column_faces[lo as usize..hi as usize].iter().map(|&f| f as usize)
     }
 
     pub fn face_columns(&self, f: usize) -> &[u32] {
@@ -95,14 +158,7 @@ impl Front {
 
     /// The faces touching any of `columns`, each once.
     pub fn faces_around_columns(&self, columns: &[u32]) -> Vec<usize> {
-        let mut faces: Vec<usize> = columns
-            .iter()
-            .flat_map(|&c| {
-                let (lo, hi) =
-                    (self.column_face_offsets[c as usize], self.column_face_offsets[c as usize + 1]);
-                self.column_faces[lo as usize..hi as usize].iter().map(|&f| f as usize)
-            })
-            .collect();
+        let mut faces: Vec<usize> = columns.iter().flat_map(|&c| self.faces_of(c)).collect();
         faces.sort_unstable();
         faces.dedup();
         faces
@@ -121,13 +177,14 @@ pub fn initial_front(surface: &Surface, normals: &WallNormals) -> (Columns, Fron
         columns.alive.push(true);
         columns.layers.push(0);
         columns.wall_vertex.push(seed.vertex);
+        columns.merged_into.push(NOT_MERGED);
     }
     let mut front = Front::default();
     for (t, corner_columns) in normals.triangle_columns.iter().enumerate() {
-        front.push(corner_columns, surface.triangle_patch[t]);
+        front.push(corner_columns, surface.triangle_patch[t], Some(t as u32));
     }
     for fan in &normals.fan_faces {
-        front.push(fan.columns(), fan.patch);
+        front.push(fan.columns(), fan.patch, None);
     }
     front.index_columns(columns.len());
     (columns, front)

@@ -1,15 +1,19 @@
 //! Marching the front layer by layer: move the live columns, keep every new cell valid, emit
 //! the slab.
 //!
-//! Each step proposes a new position for every live column (straight along its direction, at
-//! the geometric-series distance of the next layer), builds the slab cell over every front face
-//! ([`super::slab`]) and checks it with exact predicates. A column taking part in an invalid cell
-//! is stopped (its top is its bottom) and the cells around it are rebuilt, until every cell is
-//! valid; stopped columns turn their cells into pyramids and tetrahedra, so the slab stays
-//! conforming. Only then are the new nodes created and the cells emitted.
+//! Each step proposes a new position for every live column (along its direction, by the height
+//! of the next layer), merges the columns whose fronts meet ([`super::entropy`]), builds the
+//! slab cell over every front face ([`super::slab`]) and checks it with exact predicates. An
+//! invalid cell is repaired by a collapse where one of its edges is being crushed, otherwise by
+//! stopping its columns (their top is their bottom); the cells around are rebuilt until every
+//! cell is valid. Stopped and merged columns turn their cells into pyramids and tetrahedra, so
+//! the slab stays conforming. Only then are the new nodes created, the cells emitted and the
+//! merges applied to the front.
 
 use rayon::prelude::*;
 
+use super::collapse::Merges;
+use super::entropy;
 use super::front::{Columns, Front};
 use super::slab::{slab_cell, Polygon, SlabCell};
 use crate::geometry::DVec3;
@@ -28,10 +32,12 @@ pub struct MarchStats {
     pub columns_stopped_early: usize,
     /// Cells split from an added centre point (their shape was not a standard cell).
     pub steiner_points: usize,
+    /// Front edges collapsed where fronts met (two columns merged into one).
+    pub collapses: usize,
 }
 
-/// Node ids of the slab being built: committed nodes are `< committed`, a live column `c`
-/// proposes the node `committed + c`.
+/// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
+/// proposes the node `committed + c` at `proposed[c]`.
 struct Proposal<'a> {
     points: &'a [DVec3],
     proposed: &'a [DVec3],
@@ -93,14 +99,54 @@ fn split_pieces(faces: &[Polygon], centre: u32) -> impl Iterator<Item = (CellKin
     })
 }
 
-/// Bottom and top node ids of a front face, given the proposed top of every column.
-fn face_nodes(front: &Front, f: usize, top: &[u32], columns: &Columns) -> ([u32; 4], [u32; 4], usize) {
+/// The decisions for one slab: which columns move, where to, and which merge.
+pub(super) struct SlabPlan {
+    pub moving: Vec<bool>,
+    pub proposed: Vec<DVec3>,
+    pub merges: Merges,
+    /// New direction and scale of survivors placed between the two columns they merged.
+    pub redirected: Vec<(u32, DVec3, f64)>,
+    pub collapses: usize,
+}
+
+impl SlabPlan {
+    /// The top node of column `c` in the proposal's numbering.
+    fn top(&self, c: u32, columns: &Columns, committed: u32) -> u32 {
+        let r = self.merges.root(c);
+        if self.moving[r as usize] {
+            committed + r
+        } else {
+            columns.node[c as usize]
+        }
+    }
+
+    /// Stop the group of `c`'s root: the root and every column merged into it keep their node.
+    /// Returns the columns whose cells change.
+    fn stop(&mut self, c: u32) -> Vec<u32> {
+        let r = self.merges.root(c);
+        let mut changed = self.merges.release(r);
+        changed.push(r);
+        for &m in &changed {
+            self.moving[m as usize] = false;
+        }
+        changed
+    }
+}
+
+/// Bottom and top node ids of a front face under a slab plan.
+fn face_nodes(
+    front: &Front,
+    f: usize,
+    plan: &SlabPlan,
+    columns: &Columns,
+    committed: u32,
+) -> ([u32; 4], [u32; 4], usize) {
     let cols = front.face_columns(f);
     let mut b = [0; 4];
     let mut t = [0; 4];
     for (i, &c) in cols.iter().enumerate() {
         b[i] = columns.node[c as usize];
-        t[i] = top[c as usize];
+        t[i] = plan.top(c, columns, committed);
     }
     (b, t, cols.len())
 }
@@ -126,96 +172,180 @@ pub fn march(
         if !columns.alive.iter().any(|&a| a) {
             break;
         }
+        let points = &mesh.points;
         let proposed: Vec<DVec3> = (0..columns.len())
             .into_par_iter()
-            .map(|c| match distance(c, k) {
-                Some(d) if columns.alive[c] => columns.base[c] + columns.dir[c] * (columns.scale[c] * d),
+            .map(|c| match (distance(c, k), distance(c, k - 1)) {
+                (Some(d), Some(d_before)) if columns.alive[c] => {
+                    points[columns.node[c] as usize] + columns.dir[c] * (columns.scale[c] * (d - d_before))
+                }
                 _ => DVec3::ZERO,
             })
             .collect();
-        let moving = settle_slab(mesh, columns, front, &proposed);
-        stats.columns_stopped_early += columns.alive.iter().zip(&moving).filter(|(a, m)| **a && !**m).count();
-        commit_slab(mesh, columns, front, &proposed, &moving, &mut stats);
-        for (alive, m) in columns.alive.iter_mut().zip(&moving) {
-            *alive = *m;
-        }
+        let plan = settle_slab(mesh, columns, front, proposed);
+        stats.columns_stopped_early +=
+            columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
+        stats.collapses += plan.collapses;
+        commit_slab(mesh, columns, front, &plan, &mut stats);
         stats.layers_marched = k;
         on_layer(k);
     }
     stats
 }
 
-/// Decide which live columns move: stop the columns of invalid cells until every cell is valid.
-fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: &[DVec3]) -> Vec<bool> {
+/// Decide which columns move and merge so that every cell of the slab is valid.
+fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Vec<DVec3>) -> SlabPlan {
     let committed = mesh.points.len() as u32;
-    let proposal = Proposal { points: &mesh.points, proposed, committed };
-    let mut moving = columns.alive.clone();
+    let mut plan = SlabPlan {
+        moving: columns.alive.clone(),
+        proposed,
+        merges: Merges::new(columns.len()),
+        redirected: Vec::new(),
+        collapses: 0,
+    };
     let mut to_check: Vec<usize> = (0..front.len()).collect();
     while !to_check.is_empty() {
-        let top: Vec<u32> = (0..columns.len())
-            .map(|c| if moving[c] { committed + c as u32 } else { columns.node[c] })
-            .collect();
-        let invalid: Vec<usize> = to_check
-            .par_iter()
-            .copied()
-            .filter(|&f| {
-                let (b, t, n) = face_nodes(front, f, &top, columns);
-                !proposal.cell_is_valid(&slab_cell(&b[..n], &t[..n]))
-            })
-            .collect();
-        let mut stopped = Vec::new();
+        let invalid: Vec<usize> = {
+            let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+            let plan = &plan;
+            to_check
+                .par_iter()
+                .copied()
+                .filter(|&f| {
+                    let (b, t, n) = face_nodes(front, f, plan, columns, committed);
+                    !proposal.cell_is_valid(&slab_cell(&b[..n], &t[..n]))
+                })
+                .collect()
+        };
+        let mut changed = Vec::new();
         for &f in &invalid {
+            if let Some(merged) = entropy::collapse_crushed_edge(&mut plan, front, f, columns, &mesh.points) {
+                changed.extend(merged);
+                continue;
+            }
+            if tracing::enabled!(tracing::Level::DEBUG) {
+                let (b, t, n) = face_nodes(front, f, &plan, columns, committed);
+                let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+                let cols: Vec<String> = front
+                    .face_columns(f)
+                    .iter()
+                    .map(|&c| {
+                        let c = c as usize;
+                        format!(
+                            "c{c} v{} s{:.3} d{:.3?}",
+                            columns.wall_vertex[c],
+                            columns.scale[c],
+                            columns.dir[c].to_array()
+                        )
+                    })
+                    .collect();
+                let ratios: Vec<String> = (0..n)
+                    .map(|i| {
+                        let (x, y) = (b[i], b[(i + 1) % n]);
+                        let (tx, ty) = (t[i], t[(i + 1) % n]);
+                        format!(
+                            "{:.3}",
+                            super::entropy::shrink_ratio(
+                                proposal.position(x),
+                                proposal.position(y),
+                                proposal.position(tx),
+                                proposal.position(ty)
+                            )
+                        )
+                    })
+                    .collect();
+                tracing::debug!(
+                    "invalid cell over face {f}: {:?}; ratios {ratios:?}; {cols:?}",
+                    slab_cell(&b[..n], &t[..n])
+                );
+            }
             for &c in front.face_columns(f) {
-                if std::mem::replace(&mut moving[c as usize], false) {
-                    stopped.push(c);
+                if plan.moving[plan.merges.root(c) as usize] {
+                    changed.extend(plan.stop(c));
                 }
             }
         }
-        // Only the cells around a newly stopped column can change.
-        to_check = front.faces_around_columns(&stopped);
+        // Only the cells around a column that stopped or merged can change.
+        to_check = front.faces_around_columns(&changed);
     }
-    moving
+    plan
 }
 
-/// Create the nodes of the moving columns and emit the slab's cells.
+/// Create the nodes of the moving columns, emit the slab's cells and apply the merges.
 fn commit_slab(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
-    proposed: &[DVec3],
-    moving: &[bool],
+    plan: &SlabPlan,
     stats: &mut MarchStats,
 ) {
-    let mut top = columns.node.clone();
+    let mut new_node = vec![u32::MAX; columns.len()];
     for c in 0..columns.len() {
-        if moving[c] {
-            top[c] = mesh.points.len() as u32;
-            mesh.points.push(proposed[c]);
+        if plan.moving[c] && !plan.merges.is_merged(c as u32) {
+            new_node[c] = mesh.points.len() as u32;
+            mesh.points.push(plan.proposed[c]);
+        }
+    }
+    let top: Vec<u32> = (0..columns.len() as u32)
+        .map(|c| {
+            let r = plan.merges.root(c) as usize;
+            if plan.moving[r] {
+                new_node[r]
+            } else {
+                columns.node[c as usize]
+            }
+        })
+        .collect();
+    for f in 0..front.len() {
+        let cols = front.face_columns(f);
+        let n = cols.len();
+        let mut b = [0; 4];
+        let mut t = [0; 4];
+        for (i, &c) in cols.iter().enumerate() {
+            b[i] = columns.node[c as usize];
+            t[i] = top[c as usize];
+        }
+        if b[..n] != t[..n] {
+            // The top is now front, even under a flat cell whose top lies on a neighbour's face.
+            front.raise(f);
+        }
+        emit_cell(mesh, slab_cell(&b[..n], &t[..n]), stats);
+    }
+    for c in 0..columns.len() {
+        let r = plan.merges.root(c as u32) as usize;
+        if !plan.moving[r] {
+            columns.alive[c] = false;
+        } else if r != c {
+            columns.alive[c] = false;
+            columns.merged_into[c] = r as u32;
+            columns.node[c] = top[c];
+        } else {
+            columns.node[c] = top[c];
             columns.layers[c] += 1;
         }
     }
-    for f in 0..front.len() {
-        let (b, t, n) = face_nodes(front, f, &top, columns);
-        if b[..n] != t[..n] {
-            // The top is now front, even under a flat cell whose top lies on a neighbour's face.
-            front.raised[f] = true;
-        }
-        match slab_cell(&b[..n], &t[..n]) {
-            SlabCell::Empty | SlabCell::Flat => {}
-            SlabCell::Standard { kind, nodes } => {
-                mesh.push_cell(kind, &nodes[..kind.node_count()], LAYER_ZONE)
+    for &(c, dir, scale) in &plan.redirected {
+        columns.dir[c as usize] = dir;
+        columns.scale[c as usize] = scale;
+    }
+    if plan.collapses > 0 {
+        front.apply_merges(plan.merges.roots());
+    }
+}
+
+fn emit_cell(mesh: &mut VolumeMesh, cell: SlabCell, stats: &mut MarchStats) {
+    match cell {
+        SlabCell::Empty | SlabCell::Flat => {}
+        SlabCell::Standard { kind, nodes } => mesh.push_cell(kind, &nodes[..kind.node_count()], LAYER_ZONE),
+        SlabCell::Split { faces } => {
+            let centre = mesh.points.len() as u32;
+            let proposal = Proposal { points: &mesh.points, proposed: &[], committed: u32::MAX };
+            let c = proposal.centre(&faces);
+            mesh.points.push(c);
+            for (kind, nodes) in split_pieces(&faces, centre) {
+                mesh.push_cell(kind, &nodes, LAYER_ZONE);
             }
-            SlabCell::Split { faces } => {
-                let centre = mesh.points.len() as u32;
-                let proposal = Proposal { points: &mesh.points, proposed: &[], committed: u32::MAX };
-                let c = proposal.centre(&faces);
-                mesh.points.push(c);
-                for (kind, nodes) in split_pieces(&faces, centre) {
-                    mesh.push_cell(kind, &nodes, LAYER_ZONE);
-                }
-                stats.steiner_points += 1;
-            }
+            stats.steiner_points += 1;
         }
     }
-    columns.node = top;
 }

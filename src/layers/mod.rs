@@ -4,6 +4,8 @@
 //! mesh: the wall points, the layer cells (zone [`march::LAYER_ZONE`]), the wall faces under
 //! them and the final front as the boundary patch [`TOP_PATCH`].
 
+pub mod collapse;
+pub mod entropy;
 pub mod front;
 pub mod march;
 pub mod slab;
@@ -65,9 +67,11 @@ pub fn build_layers(
     for c in 0..columns.len() {
         let v = columns.wall_vertex[c] as usize;
         if let Some(t) = target(c) {
-            vertex_layers[v] = Some(vertex_layers[v].map_or(columns.layers[c], |l| l.min(columns.layers[c])));
+            // A column that merged is carried on by the bisector column it merged into.
+            let reached = columns.layers[columns.carrier(c)];
+            vertex_layers[v] = Some(vertex_layers[v].map_or(reached, |l| l.min(reached)));
             vertex_target[v] = Some(vertex_target[v].map_or(t, |x| x.max(t)));
-            if columns.layers[c] < t {
+            if reached < t {
                 stopped_vertices.push(v as u32);
             }
         }
@@ -106,7 +110,7 @@ fn add_boundary(mesh: &mut VolumeMesh, surface: &Surface, front: &front::Front, 
     let top_patch = mesh.patch_names.len() as u32;
     mesh.patch_names.push(TOP_PATCH.to_owned());
     for t in 0..surface.triangles.len() {
-        if front.raised[t] {
+        if front.wall_raised.get(t).copied().unwrap_or(false) {
             let [a, b, c] = surface.triangles[t];
             mesh.boundary.triangles.push([a, c, b]);
             mesh.boundary.triangle_patch.push(surface.triangle_patch[t]);
