@@ -17,6 +17,7 @@ pub mod io;
 pub mod layers;
 pub mod mesh;
 pub mod normals;
+pub mod picture;
 pub mod pipeline;
 pub mod progress;
 pub mod quality;
