@@ -101,3 +101,50 @@ fn cube_in_a_box_without_layers() {
     }
     eprintln!("cube without layers: {stats:?}");
 }
+
+mod properties {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::mesh::CellKind;
+    use crate::quality::validity::cell_validity;
+
+    proptest! {
+        /// Whatever the quad, a pyramid is only ever proposed valid.
+        #[test]
+        fn proposed_pyramids_are_valid(coords in proptest::collection::vec(-1.0f64..1.0, 12)) {
+            let x: Vec<DVec3> = coords.chunks(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
+            if let Some(apex) = front::pyramid_apex([x[0], x[1], x[2], x[3]]) {
+                let mut p = [DVec3::ZERO; 8];
+                p[..4].copy_from_slice(&x);
+                p[4] = apex;
+                prop_assert!(cell_validity(CellKind::Pyramid, &p).is_valid());
+            }
+        }
+    }
+
+    #[cfg(feature = "tetgen")]
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+        /// Boxes of any proportions, resolution and farfield: a valid mesh of the right volume.
+        #[test]
+        fn any_box_in_any_farfield_fills_validly(
+            size in (0.05f64..20.0, 0.05f64..20.0, 0.05f64..20.0),
+            n in 1usize..4,
+            factor in 2.0f64..40.0,
+            sphere in any::<bool>(),
+        ) {
+            let wall = shapes::cuboid(DVec3::new(size.0, size.1, size.2), n);
+            let shape = if sphere { crate::config::FarfieldShape::Sphere } else { crate::config::FarfieldShape::Box };
+            let spec = FarfieldSpec { shape, factor, cell_size: None };
+            let options = CoreOptions { farfield: Some(spec) };
+            let (mesh, stats) = fill_core(&bare_wall(&wall), &wall, &options).unwrap();
+            let check = quality::check(&mesh);
+            prop_assert!(check.is_valid(), "{}", check);
+            let far = farfield::farfield(&spec, wall.bounding_box()).unwrap();
+            let expected = -far.enclosed_volume() - wall.enclosed_volume();
+            prop_assert!((check.volume.cells - expected).abs() <= 1e-9 * expected);
+            prop_assert_eq!(stats.boundary_steiner_points, 0);
+        }
+    }
+}
