@@ -4,10 +4,10 @@
 use std::collections::HashSet;
 
 use super::{farfield, ClosedBoundary, FarfieldSpec, FillError, CORE_ZONE_NAME, FARFIELD_PATCH};
-use super::{MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
+use super::{sorted_triangle, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
 use crate::geometry::DVec3;
 use crate::layers::TOP_PATCH;
-use crate::mesh::{CellKind, VolumeMesh};
+use crate::mesh::{BoundaryFaces, CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
 use crate::quality::validity::cell_validity;
 use crate::surface::Surface;
@@ -70,32 +70,25 @@ fn without_top(layers: &VolumeMesh) -> (VolumeMesh, Vec<[u32; 3]>, Vec<[u32; 4]>
         return (mesh, Vec::new(), Vec::new());
     };
     mesh.patch_names.remove(top as usize);
-    let renumber = |p: u32| if p > top { p - 1 } else { p };
     let b = std::mem::take(&mut mesh.boundary);
-    let mut front_triangles = Vec::new();
-    for (t, p) in b.triangles.into_iter().zip(b.triangle_patch) {
-        if p == top {
-            front_triangles.push(t);
-        } else {
-            mesh.boundary.triangles.push(t);
-            mesh.boundary.triangle_patch.push(renumber(p));
-        }
-    }
-    let mut front_quads = Vec::new();
-    for (q, p) in b.quads.into_iter().zip(b.quad_patch) {
-        if p == top {
-            front_quads.push(q);
-        } else {
-            mesh.boundary.quads.push(q);
-            mesh.boundary.quad_patch.push(renumber(p));
-        }
-    }
+    let (triangles, triangle_patch, front_triangles) = split_off(b.triangles, b.triangle_patch, top);
+    let (quads, quad_patch, front_quads) = split_off(b.quads, b.quad_patch, top);
+    mesh.boundary = BoundaryFaces { triangles, triangle_patch, quads, quad_patch };
     (mesh, front_triangles, front_quads)
 }
 
-fn sorted(mut t: [u32; 3]) -> [u32; 3] {
-    t.sort_unstable();
-    t
+/// The faces of patch `top` apart; the others with their patches renumbered without `top`.
+fn split_off<F>(faces: Vec<F>, patches: Vec<u32>, top: u32) -> (Vec<F>, Vec<u32>, Vec<F>) {
+    let (mut kept, mut kept_patches, mut taken) = (Vec::new(), Vec::new(), Vec::new());
+    for (face, p) in faces.into_iter().zip(patches) {
+        if p == top {
+            taken.push(face);
+        } else {
+            kept.push(face);
+            kept_patches.push(if p > top { p - 1 } else { p });
+        }
+    }
+    (kept, kept_patches, taken)
 }
 
 impl CoreBuild {
@@ -107,9 +100,10 @@ impl CoreBuild {
     /// Wall triangles under no layer cell are on the front as they are (facing the fluid) and
     /// boundary faces of the mesh (reversed: out of the domain, into the body).
     fn add_uncovered_wall(&mut self, wall: &Surface) {
-        let covered: HashSet<[u32; 3]> = self.mesh.boundary.triangles.iter().map(|&t| sorted(t)).collect();
+        let covered: HashSet<[u32; 3]> =
+            self.mesh.boundary.triangles.iter().map(|&t| sorted_triangle(t)).collect();
         for (t, &[a, b, c]) in wall.triangles.iter().enumerate() {
-            if !covered.contains(&sorted([a, b, c])) {
+            if !covered.contains(&sorted_triangle([a, b, c])) {
                 self.push([a, b, c], MARKER_WALL);
                 self.mesh.boundary.triangles.push([a, c, b]);
                 self.mesh.boundary.triangle_patch.push(wall.triangle_patch[t]);

@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use super::front::CoreBuild;
-use super::{ClosedBoundary, CoreStats, CoreTets, FillError};
+use super::{sorted_triangle, ClosedBoundary, CoreStats, CoreTets, FillError};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -25,11 +25,11 @@ pub(super) fn check_boundary_kept(boundary: &ClosedBoundary, core: &CoreTets) ->
     }
     check_tets_positive(core)?;
     let index: HashMap<[u32; 3], usize> =
-        boundary.triangles.iter().enumerate().map(|(t, &tri)| (sorted(tri), t)).collect();
+        boundary.triangles.iter().enumerate().map(|(t, &tri)| (sorted_triangle(tri), t)).collect();
     let mut tets_on = vec![0usize; boundary.triangles.len()];
     for tet in &core.tets {
         for face in CellKind::Tetrahedron.faces() {
-            let key = sorted([tet[face[0]], tet[face[1]], tet[face[2]]]);
+            let key = sorted_triangle([tet[face[0]], tet[face[1]], tet[face[2]]]);
             let Some(&t) = index.get(&key) else { continue };
             let opposite = tet.iter().copied().find(|v| !key.contains(v)).unwrap_or(tet[0]);
             let [a, b, c] = boundary.triangles[t].map(|v| core.points[v as usize]);
@@ -71,11 +71,6 @@ fn check_tets_positive(core: &CoreTets) -> Result<(), FillError> {
         }
     }
     Ok(())
-}
-
-fn sorted(mut t: [u32; 3]) -> [u32; 3] {
-    t.sort_unstable();
-    t
 }
 
 /// Append the mesher's points and tetrahedra (boundary point `i` is mesh node `nodes[i]`).

@@ -18,7 +18,7 @@ use std::time::Instant;
 use serde::Serialize;
 
 use crate::config::{Config, FarfieldShape, Flow};
-use crate::geometry::DVec3;
+use crate::geometry::{triangle_area_vector, DVec3};
 use crate::mesh::VolumeMesh;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
@@ -53,10 +53,38 @@ pub struct ClosedBoundary {
 }
 
 impl ClosedBoundary {
+    /// Markers for every triangle, node indices in range, finite points, no triangle of zero
+    /// area.
+    pub fn check_structure(&self) -> Result<(), FillError> {
+        let n = self.points.len();
+        if self.markers.len() != self.triangles.len() {
+            let (m, t) = (self.markers.len(), self.triangles.len());
+            return Err(FillError::Input(format!("{m} markers for {t} triangles")));
+        }
+        if let Some(p) = self.points.iter().position(|p| !p.is_finite()) {
+            return Err(FillError::Input(format!("point {p} is not finite: {:?}", self.points[p])));
+        }
+        if let Some(t) = self.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
+            return Err(FillError::Input(format!("triangle {t} {:?} has a node >= {n}", self.triangles[t])));
+        }
+        let flat = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|v| self.points[v as usize]);
+            triangle_area_vector(a, b, c) == DVec3::ZERO
+        };
+        match self.triangles.iter().position(flat) {
+            Some(t) => {
+                let points = self.triangles[t].map(|v| self.points[v as usize].to_array());
+                Err(FillError::Input(format!("triangle {t} {:?} has no area: {points:?}", self.triangles[t])))
+            }
+            None => Ok(()),
+        }
+    }
+
     /// One point inside every hole of the region (behind each shell that encloses a positive
     /// volume), strictly away from every triangle. An error when no shell bounds the region from
     /// outside (it would be unbounded).
     pub fn hole_points(&self) -> Result<Vec<DVec3>, FillError> {
+        self.check_structure()?;
         let surface = self.as_surface();
         let topology = Topology::new(&surface);
         let (start, triangles) = topology.shell_triangles();
@@ -88,6 +116,7 @@ impl ClosedBoundary {
     /// An error naming a few pairs of triangles that cross or touch where they should not
     /// (exact tests; see [`crate::surface::validate::intersecting_pairs`]).
     pub fn check_no_self_intersection(&self) -> Result<(), FillError> {
+        self.check_structure()?;
         let surface = self.as_surface();
         let pairs = crate::surface::validate::intersecting_pairs(&surface);
         if pairs.is_empty() {
@@ -139,6 +168,12 @@ fn marker_name(marker: u32) -> &'static str {
         MARKER_FARFIELD => "farfield",
         _ => "boundary",
     }
+}
+
+/// The nodes of a triangle in increasing order: the key of the triangle whatever its orientation.
+fn sorted_triangle(mut t: [u32; 3]) -> [u32; 3] {
+    t.sort_unstable();
+    t
 }
 
 /// Target edge length of the tetrahedra at every boundary point; the mesher grades in between.

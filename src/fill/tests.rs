@@ -148,3 +148,34 @@ mod properties {
         }
     }
 }
+
+#[test]
+fn broken_boundaries_are_errors_not_crashes() {
+    let cube = shapes::cuboid(DVec3::splat(1.0), 1);
+    let good = ClosedBoundary {
+        points: cube.points.clone(),
+        triangles: cube.triangles.clone(),
+        markers: vec![0; 12],
+    };
+    good.check_structure().unwrap();
+    let mut out_of_range = good.clone();
+    out_of_range.triangles[3][1] = 99;
+    let mut nan = good.clone();
+    nan.points[2].y = f64::NAN;
+    let mut flat = good.clone();
+    flat.triangles[0] = [0, 1, 1];
+    let mut unmarked = good.clone();
+    unmarked.markers.pop();
+    for broken in [out_of_range, nan, flat, unmarked] {
+        assert!(matches!(broken.check_structure(), Err(FillError::Input(_))));
+        assert!(broken.hole_points().is_err() && broken.check_no_self_intersection().is_err());
+    }
+    // A cube crossing another one is reported before any mesher sees it.
+    let mut crossing = good.clone();
+    let offset = crossing.points.len() as u32;
+    crossing.points.extend(cube.points.iter().map(|p| *p + DVec3::splat(0.5)));
+    crossing.triangles.extend(cube.triangles.iter().map(|t| t.map(|v| v + offset)));
+    crossing.markers.resize(24, MARKER_FRONT);
+    let e = crossing.check_no_self_intersection().unwrap_err();
+    assert!(matches!(e, FillError::SelfIntersecting { .. }), "{e}");
+}

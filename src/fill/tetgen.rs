@@ -82,29 +82,12 @@ struct Input {
 
 impl Input {
     fn new(boundary: &ClosedBoundary, sizes: Option<&[f64]>) -> Result<Input, FillError> {
-        let n = boundary.points.len();
         let fits = |count: usize, what: &str| {
             c_int::try_from(count)
                 .map_err(|_| FillError::Input(format!("{count} {what} are too many for TetGen")))
         };
-        fits(n, "points")?;
+        fits(boundary.points.len(), "points")?;
         fits(boundary.triangles.len(), "triangles")?;
-        if boundary.markers.len() != boundary.triangles.len() {
-            return Err(FillError::Input(format!(
-                "{} markers for {} triangles",
-                boundary.markers.len(),
-                boundary.triangles.len()
-            )));
-        }
-        if let Some(p) = boundary.points.iter().position(|p| !p.is_finite()) {
-            return Err(FillError::Input(format!("point {p} is not finite: {:?}", boundary.points[p])));
-        }
-        if let Some(t) = boundary.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
-            return Err(FillError::Input(format!(
-                "triangle {t} {:?} has a node >= {n}",
-                boundary.triangles[t]
-            )));
-        }
         if let Some(p) = sizes.and_then(|s| s.iter().position(|x| !(x.is_finite() && *x >= 0.0))) {
             return Err(FillError::Input(format!("the size at point {p} is not a length")));
         }
@@ -114,6 +97,7 @@ impl Input {
         Ok(Input {
             points: boundary.points.iter().flat_map(|p| p.to_array()).collect(),
             sizes: sizes.map(<[f64]>::to_vec),
+            // Node indices are < the point count, which fits c_int.
             triangles: boundary.triangles.iter().flatten().map(|&v| v as c_int).collect(),
             markers: boundary.markers.iter().map(|&m| c_int::try_from(m).unwrap_or(c_int::MAX)).collect(),
             holes: holes.iter().flat_map(|p| p.to_array()).collect(),
