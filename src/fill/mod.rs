@@ -325,8 +325,9 @@ pub fn fill_core(
     }
 }
 
-/// Fill the core of `layers` (built by [`crate::layers::build_layers`] from `wall`, whose points
-/// are its first points) and return the whole mesh: the layer cells, the pyramids on the front
+/// Fill the core of `layers` (built by [`crate::layers::build_layers`] from `wall` exactly as
+/// that got it: validated, and flipped for internal flow; its points are the mesh's first
+/// points) and return the whole mesh: the layer cells, the pyramids on the front
 /// quads and the core tetrahedra (zone [`CORE_ZONE_NAME`]); boundary patches are the wall's and
 /// [`FARFIELD_PATCH`] (the layers' top faces are interior now).
 pub fn fill_core_with(
