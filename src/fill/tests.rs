@@ -16,14 +16,19 @@ fn bare_wall(wall: &Surface) -> VolumeMesh {
     }
 }
 
+/// A surface as a boundary, every triangle marked as wall.
+fn boundary_of(s: &Surface) -> ClosedBoundary {
+    ClosedBoundary {
+        points: s.points.clone(),
+        triangles: s.triangles.clone(),
+        markers: vec![MARKER_WALL; s.triangles.len()],
+    }
+}
+
 #[test]
 fn hole_points_lie_inside_bodies_only() {
     let cube = shapes::cuboid(DVec3::splat(1.0), 2);
-    let boundary = ClosedBoundary {
-        points: cube.points.clone(),
-        triangles: cube.triangles.clone(),
-        markers: vec![MARKER_WALL; cube.triangles.len()],
-    };
+    let boundary = boundary_of(&cube);
     let mut with_farfield = boundary.clone();
     let far = farfield::farfield(&FarfieldSpec::default(), cube.bounding_box()).unwrap();
     let offset = with_farfield.points.len() as u32;
@@ -44,7 +49,7 @@ fn hole_points_lie_inside_bodies_only() {
 #[test]
 fn sizing_is_the_mean_edge_length() {
     let cube = shapes::cuboid(DVec3::splat(2.0), 1);
-    let boundary = ClosedBoundary { points: cube.points, triangles: cube.triangles, markers: vec![0; 12] };
+    let boundary = boundary_of(&cube);
     let sizing = PointSizing::mean_edge_length(&boundary);
     // Every edge is 2 or 2 sqrt(2) long; each corner's mean lies between.
     assert!(sizing.size.iter().all(|&s| s > 2.0 && s < 2.0 * 2f64.sqrt()), "{:?}", sizing.size);
@@ -152,11 +157,7 @@ mod properties {
 #[test]
 fn broken_boundaries_are_errors_not_crashes() {
     let cube = shapes::cuboid(DVec3::splat(1.0), 1);
-    let good = ClosedBoundary {
-        points: cube.points.clone(),
-        triangles: cube.triangles.clone(),
-        markers: vec![0; 12],
-    };
+    let good = boundary_of(&cube);
     good.check_structure().unwrap();
     let mut out_of_range = good.clone();
     out_of_range.triangles[3][1] = 99;
