@@ -12,6 +12,7 @@
 
 pub mod cli;
 pub mod config;
+pub mod fill;
 pub mod geometry;
 pub mod io;
 pub mod layers;

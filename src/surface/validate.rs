@@ -485,7 +485,7 @@ fn duplicate_triangles(triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
 
 /// All intersecting pairs (a < b): an R-tree of the triangles' boxes proposes the pairs whose
 /// boxes touch, the exact tests decide (see [`triangle_pair_intersects`]).
-fn intersecting_pairs(surface: &Surface) -> Vec<(u32, u32)> {
+pub fn intersecting_pairs(surface: &Surface) -> Vec<(u32, u32)> {
     let boxes: Vec<GeomWithData<Rectangle<[f64; 3]>, u32>> = (0..surface.triangles.len())
         .map(|t| {
             let b = Aabb::from_points(&surface.triangle_points(t));

@@ -1,0 +1,104 @@
+//! Checking the mesher's output against the boundary it was given, and merging it into the
+//! layered mesh.
+
+use std::collections::HashMap;
+
+use super::front::CoreBuild;
+use super::{sorted_triangle, ClosedBoundary, CoreStats, CoreTets, FillError};
+use crate::geometry::predicates::{orient3d, Sign};
+use crate::geometry::DVec3;
+use crate::mesh::{CellKind, VolumeMesh};
+use crate::quality::measures::{dihedral_range, edge_face_pairs};
+
+/// The tetrahedra must be positive, keep the boundary points first and unchanged, and have
+/// every boundary triangle as a face of exactly one tetrahedron, on its inner side.
+pub(super) fn check_boundary_kept(boundary: &ClosedBoundary, core: &CoreTets) -> Result<(), FillError> {
+    let n = boundary.points.len();
+    if core.points.len() < n {
+        return Err(FillError::BadOutput(format!("{} points for {n} boundary points", core.points.len())));
+    }
+    if let Some(i) = (0..n).find(|&i| core.points[i] != boundary.points[i]) {
+        return Err(FillError::BadOutput(format!(
+            "point {i} moved from {:?} to {:?} (of {n} boundary points)",
+            boundary.points[i], core.points[i]
+        )));
+    }
+    check_tets_positive(core)?;
+    let index: HashMap<[u32; 3], usize> =
+        boundary.triangles.iter().enumerate().map(|(t, &tri)| (sorted_triangle(tri), t)).collect();
+    let mut tets_on = vec![0usize; boundary.triangles.len()];
+    for tet in &core.tets {
+        for face in CellKind::Tetrahedron.faces() {
+            let key = sorted_triangle([tet[face[0]], tet[face[1]], tet[face[2]]]);
+            let Some(&t) = index.get(&key) else { continue };
+            let opposite = tet.iter().copied().find(|v| !key.contains(v)).unwrap_or(tet[0]);
+            let [a, b, c] = boundary.triangles[t].map(|v| core.points[v as usize]);
+            if orient3d(a, b, c, core.points[opposite as usize]) == Sign::Positive {
+                tets_on[t] += 1;
+            } else {
+                // A tetrahedron outside the region (behind a boundary triangle) is never right.
+                tets_on[t] += 2;
+            }
+        }
+    }
+    match tets_on.iter().position(|&k| k != 1) {
+        None => Ok(()),
+        Some(t) => {
+            let nodes = boundary.triangles[t];
+            let centre = nodes.iter().map(|&v| core.points[v as usize]).sum::<DVec3>() / 3.0;
+            Err(FillError::BoundaryNotKept {
+                triangle: t,
+                nodes,
+                centre: centre.to_array(),
+                tets: tets_on[t],
+            })
+        }
+    }
+}
+
+fn check_tets_positive(core: &CoreTets) -> Result<(), FillError> {
+    let points = core.points.len();
+    for (i, tet) in core.tets.iter().enumerate() {
+        if tet.iter().any(|&v| v as usize >= points) {
+            return Err(FillError::BadOutput(format!("tetrahedron {i} {tet:?} has a node >= {points}")));
+        }
+        let [a, b, c, d] = tet.map(|v| core.points[v as usize]);
+        if orient3d(a, b, c, d) != Sign::Positive {
+            return Err(FillError::BadOutput(format!(
+                "tetrahedron {i} {tet:?} is not positive: {:?}",
+                [a, b, c, d].map(|p| p.to_array())
+            )));
+        }
+    }
+    Ok(())
+}
+
+/// Append the mesher's points and tetrahedra (boundary point `i` is mesh node `nodes[i]`).
+pub(super) fn merge(build: CoreBuild, nodes: &[u32], core: &CoreTets) -> (VolumeMesh, CoreStats) {
+    let CoreBuild { mut mesh, core_zone, pyramids, .. } = build;
+    let offset = mesh.points.len() as u32;
+    let n = nodes.len() as u32;
+    mesh.points.extend_from_slice(&core.points[nodes.len()..]);
+    let node = |v: u32| if v < n { nodes[v as usize] } else { offset + (v - n) };
+    let pairs = edge_face_pairs(CellKind::Tetrahedron);
+    let (mut min_dihedral, mut max_dihedral) = (f64::INFINITY, f64::NEG_INFINITY);
+    for tet in &core.tets {
+        let mut x = [DVec3::ZERO; 8];
+        for (xi, &v) in x.iter_mut().zip(tet) {
+            *xi = core.points[v as usize];
+        }
+        let (lo, hi) = dihedral_range(CellKind::Tetrahedron, &x, &pairs);
+        min_dihedral = min_dihedral.min(lo);
+        max_dihedral = max_dihedral.max(hi);
+        mesh.push_cell(CellKind::Tetrahedron, &tet.map(node), core_zone);
+    }
+    let stats = CoreStats {
+        tetrahedra: core.tets.len(),
+        pyramids,
+        steiner_points: core.points.len() - nodes.len(),
+        min_dihedral,
+        max_dihedral,
+        ..Default::default()
+    };
+    (mesh, stats)
+}

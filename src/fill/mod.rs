@@ -1,0 +1,358 @@
+//! Core fill (DESIGN.md step 7): isotropic tetrahedra between the final layer front and the
+//! farfield, merged with the layers into one conforming hybrid mesh.
+//!
+//! [`fill_core`] gathers the core's boundary from the layered mesh ([`front`]): the top faces
+//! of the layers (patch [`crate::layers::TOP_PATCH`]), the wall triangles where no layer was
+//! built, and a pyramid on every quad of the front (a tetrahedral mesher takes triangles only);
+//! adds the farfield ([`farfield`]); has a [`CoreMesher`] fill the region with tetrahedra that
+//! keep every boundary triangle exactly; and checks that they do before merging.
+
+pub mod farfield;
+mod front;
+mod merge;
+#[cfg(feature = "tetgen")]
+pub mod tetgen;
+
+use std::time::Instant;
+
+use serde::Serialize;
+
+use crate::config::{Config, FarfieldShape, Flow};
+use crate::geometry::{triangle_area_vector, DVec3};
+use crate::mesh::VolumeMesh;
+use crate::surface::topology::Topology;
+use crate::surface::Surface;
+
+/// Volume zone of the core cells (tetrahedra and the pyramids on front quads).
+pub const CORE_ZONE_NAME: &str = "core";
+/// Boundary patch of the generated farfield.
+pub const FARFIELD_PATCH: &str = "farfield";
+/// Default farfield extent (box side or sphere diameter) in body sizes (bounding-box diagonals).
+pub const DEFAULT_FARFIELD_FACTOR: f64 = 20.0;
+/// Default edge length of the farfield triangles, in body sizes.
+pub const DEFAULT_FARFIELD_CELL: f64 = 2.0;
+
+/// Markers of the [`ClosedBoundary`] triangles built by [`fill_core`].
+pub const MARKER_FRONT: u32 = 1;
+pub const MARKER_WALL: u32 = 2;
+pub const MARKER_FARFIELD: u32 = 3;
+
+/// The closed triangle surface around the region to fill: every triangle's right-hand normal
+/// points INTO the region (the convention of [`Surface`] for the fluid), so the tetrahedron on a
+/// triangle `(a, b, c)` has its fourth node `d` with `orient3d(a, b, c, d)` positive. A shell
+/// whose triangles face away from what it encloses (a body: positive enclosed volume) is a hole
+/// of the region; a shell facing inward (the farfield, or the wall of an internal flow) bounds
+/// it from outside.
+#[derive(Clone, Debug, Default)]
+pub struct ClosedBoundary {
+    pub points: Vec<DVec3>,
+    pub triangles: Vec<[u32; 3]>,
+    /// One marker per triangle (for [`fill_core`]: [`MARKER_FRONT`], [`MARKER_WALL`] or
+    /// [`MARKER_FARFIELD`]).
+    pub markers: Vec<u32>,
+}
+
+impl ClosedBoundary {
+    /// Markers for every triangle, node indices in range, finite points, no triangle of zero
+    /// area.
+    pub fn check_structure(&self) -> Result<(), FillError> {
+        let n = self.points.len();
+        if self.markers.len() != self.triangles.len() {
+            let (m, t) = (self.markers.len(), self.triangles.len());
+            return Err(FillError::Input(format!("{m} markers for {t} triangles")));
+        }
+        if let Some(p) = self.points.iter().position(|p| !p.is_finite()) {
+            return Err(FillError::Input(format!("point {p} is not finite: {:?}", self.points[p])));
+        }
+        if let Some(t) = self.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= n)) {
+            return Err(FillError::Input(format!("triangle {t} {:?} has a node >= {n}", self.triangles[t])));
+        }
+        let flat = |t: &[u32; 3]| {
+            let [a, b, c] = t.map(|v| self.points[v as usize]);
+            triangle_area_vector(a, b, c) == DVec3::ZERO
+        };
+        match self.triangles.iter().position(flat) {
+            Some(t) => {
+                let points = self.triangles[t].map(|v| self.points[v as usize].to_array());
+                Err(FillError::Input(format!("triangle {t} {:?} has no area: {points:?}", self.triangles[t])))
+            }
+            None => Ok(()),
+        }
+    }
+
+    /// One point inside every hole of the region (behind each shell that encloses a positive
+    /// volume), strictly away from every triangle. An error when no shell bounds the region from
+    /// outside (it would be unbounded).
+    pub fn hole_points(&self) -> Result<Vec<DVec3>, FillError> {
+        self.check_structure()?;
+        let surface = self.as_surface();
+        let topology = Topology::new(&surface);
+        let (start, triangles) = topology.shell_triangles();
+        let mut holes = Vec::new();
+        let mut outer_shells = 0;
+        for w in start.windows(2) {
+            let shell = &triangles[w[0] as usize..w[1] as usize];
+            let volume: f64 = shell
+                .iter()
+                .map(|&t| surface.triangle_points(t as usize))
+                .map(|[a, b, c]| a.dot(b.cross(c)))
+                .sum();
+            if volume > 0.0 {
+                holes.extend(self.point_behind(&surface, shell));
+            } else {
+                outer_shells += 1;
+            }
+        }
+        if outer_shells == 0 {
+            return Err(FillError::Input(format!(
+                "none of the {} shells bounds the region from outside (no farfield, and no shell \
+                 facing inward)",
+                start.len().saturating_sub(1)
+            )));
+        }
+        Ok(holes)
+    }
+
+    /// An error naming a few pairs of triangles that cross or touch where they should not
+    /// (exact tests; see [`crate::surface::validate::intersecting_pairs`]).
+    pub fn check_no_self_intersection(&self) -> Result<(), FillError> {
+        self.check_structure()?;
+        let surface = self.as_surface();
+        let pairs = crate::surface::validate::intersecting_pairs(&surface);
+        if pairs.is_empty() {
+            return Ok(());
+        }
+        let describe = |t: u32| {
+            let [a, b, c] = surface.triangle_points(t as usize);
+            let marker = self.markers.get(t as usize).copied().unwrap_or(0);
+            format!("{} triangle {t} at {:?}", marker_name(marker), ((a + b + c) / 3.0).to_array())
+        };
+        let examples = pairs.iter().take(5).map(|&(s, t)| format!("{} and {}", describe(s), describe(t)));
+        Err(FillError::SelfIntersecting { pairs: pairs.len(), examples: examples.collect() })
+    }
+
+    fn as_surface(&self) -> Surface {
+        Surface {
+            points: self.points.clone(),
+            triangles: self.triangles.clone(),
+            triangle_patch: vec![0; self.triangles.len()],
+            patch_names: vec![String::new()],
+        }
+    }
+
+    /// A point behind the largest triangle of `shell`, half way to the nearest other triangle.
+    fn point_behind(&self, surface: &Surface, shell: &[u32]) -> Option<DVec3> {
+        let &largest = shell.iter().max_by(|&&s, &&t| {
+            let area = |t: u32| surface.triangle_area_vector(t as usize).length();
+            area(s).total_cmp(&area(t))
+        })?;
+        let [a, b, c] = surface.triangle_points(largest as usize);
+        let centre = (a + b + c) / 3.0;
+        let clearance = (0..self.triangles.len())
+            .filter(|&t| t != largest as usize)
+            .map(|t| {
+                let [p, q, r] = surface.triangle_points(t);
+                (crate::geometry::distance::closest_point_on_triangle(centre, p, q, r) - centre).length()
+            })
+            .fold(f64::INFINITY, f64::min);
+        let normal = surface.triangle_normal(largest as usize);
+        (clearance.is_finite() && clearance > 0.0).then(|| centre - normal * (0.5 * clearance))
+    }
+}
+
+/// What a [`ClosedBoundary`] marker of [`fill_core`] stands for.
+fn marker_name(marker: u32) -> &'static str {
+    match marker {
+        MARKER_FRONT => "front",
+        MARKER_WALL => "wall",
+        MARKER_FARFIELD => "farfield",
+        _ => "boundary",
+    }
+}
+
+/// The nodes of a triangle in increasing order: the key of the triangle whatever its orientation.
+fn sorted_triangle(mut t: [u32; 3]) -> [u32; 3] {
+    t.sort_unstable();
+    t
+}
+
+/// Target edge length of the tetrahedra at every boundary point; the mesher grades in between.
+#[derive(Clone, Debug, Default)]
+pub struct PointSizing {
+    pub size: Vec<f64>,
+}
+
+impl PointSizing {
+    /// The mean length of the boundary edges at every point (each edge counted once per
+    /// triangle using it, so both sides weigh alike).
+    pub fn mean_edge_length(boundary: &ClosedBoundary) -> PointSizing {
+        let n = boundary.points.len();
+        let (mut sum, mut count) = (vec![0.0; n], vec![0u32; n]);
+        for t in &boundary.triangles {
+            for i in 0..3 {
+                let (a, b) = (t[i] as usize, t[(i + 1) % 3] as usize);
+                let length = boundary.points[a].distance(boundary.points[b]);
+                for v in [a, b] {
+                    sum[v] += length;
+                    count[v] += 1;
+                }
+            }
+        }
+        let size = sum.iter().zip(&count).map(|(s, &c)| if c > 0 { s / c as f64 } else { 0.0 }).collect();
+        PointSizing { size }
+    }
+}
+
+/// What a [`CoreMesher`] returns: the boundary points first, unchanged and in order, then the
+/// points it added; tetrahedra positive in the Gmsh convention (`orient3d` positive).
+#[derive(Clone, Debug, Default)]
+pub struct CoreTets {
+    pub points: Vec<DVec3>,
+    pub tets: Vec<[u32; 4]>,
+    /// Added points lying on the boundary (the fill must keep the boundary: always 0 when
+    /// [`CoreMesher::fill`] succeeds through [`fill_core`]).
+    pub boundary_steiner_points: usize,
+}
+
+/// Fills the region bounded by a [`ClosedBoundary`] with tetrahedra, keeping every boundary
+/// triangle as a face of exactly one tetrahedron (no point added on the boundary).
+pub trait CoreMesher {
+    fn fill(&self, boundary: &ClosedBoundary, sizing: &PointSizing) -> Result<CoreTets, FillError>;
+}
+
+#[derive(Debug, thiserror::Error)]
+pub enum FillError {
+    #[error("the wall surface does not match the layered mesh: {0}")]
+    WallMismatch(String),
+    #[error("invalid core options: {0}")]
+    Options(String),
+    #[error("no valid pyramid fits on the front quad {nodes:?} (centre {centre:?}): the front folds there")]
+    NoPyramid { nodes: [u32; 4], centre: [f64; 3] },
+    #[error(
+        "the core boundary intersects itself ({pairs} pairs of triangles; the layers' front folds or \
+         crosses itself, or reaches the farfield), e.g. {}", examples.join("; ")
+    )]
+    SelfIntersecting { pairs: usize, examples: Vec<String> },
+    #[error("the core boundary cannot be passed to the mesher: {0}")]
+    Input(String),
+    #[error("TetGen failed (code {code}): {message}")]
+    TetGen { code: i32, message: String },
+    #[error("the mesher returned a broken mesh: {0}")]
+    BadOutput(String),
+    #[error(
+        "the mesher did not keep the boundary triangle {triangle} (nodes {nodes:?}, centre {centre:?}): \
+         it is a face of {tets} tetrahedra on its inner side"
+    )]
+    BoundaryNotKept { triangle: usize, nodes: [u32; 3], centre: [f64; 3], tets: usize },
+    #[error("blmesh was built without a core mesher (enable the cargo feature `tetgen`)")]
+    NoMesher,
+}
+
+/// The farfield around an external body.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct FarfieldSpec {
+    pub shape: FarfieldShape,
+    /// Box side or sphere diameter, in body sizes (bounding-box diagonal of the wall).
+    pub factor: f64,
+    /// Edge length of the farfield triangles (absolute); `None`: [`DEFAULT_FARFIELD_CELL`] body
+    /// sizes.
+    pub cell_size: Option<f64>,
+}
+
+impl Default for FarfieldSpec {
+    fn default() -> Self {
+        FarfieldSpec { shape: FarfieldShape::Box, factor: DEFAULT_FARFIELD_FACTOR, cell_size: None }
+    }
+}
+
+/// Options of the core fill.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct CoreOptions {
+    /// The outer boundary; `None` for internal flow (the front alone bounds the core).
+    pub farfield: Option<FarfieldSpec>,
+}
+
+impl Default for CoreOptions {
+    /// External flow in the default box farfield.
+    fn default() -> Self {
+        CoreOptions { farfield: Some(FarfieldSpec::default()) }
+    }
+}
+
+impl CoreOptions {
+    /// A farfield of the configured shape for external flow, none for internal flow.
+    pub fn from_config(config: &Config) -> Self {
+        let farfield = match config.flow {
+            Flow::External => Some(FarfieldSpec { shape: config.farfield, ..Default::default() }),
+            Flow::Internal => None,
+        };
+        CoreOptions { farfield }
+    }
+}
+
+/// What the fill did, for the report.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CoreStats {
+    pub tetrahedra: usize,
+    /// Pyramids put on the quads of the front.
+    pub pyramids: usize,
+    /// Points the mesher added inside the core.
+    pub steiner_points: usize,
+    /// Points the mesher added on the boundary (0: the front is kept exactly).
+    pub boundary_steiner_points: usize,
+    /// Smallest and largest dihedral angle of the core tetrahedra, degrees.
+    pub min_dihedral: f64,
+    pub max_dihedral: f64,
+    /// Wall-clock time of the whole fill and of the mesher alone, seconds.
+    pub seconds: f64,
+    pub mesher_seconds: f64,
+}
+
+/// Fill the core of a layered mesh with TetGen; see [`fill_core_with`].
+pub fn fill_core(
+    layers: &VolumeMesh,
+    wall: &Surface,
+    options: &CoreOptions,
+) -> Result<(VolumeMesh, CoreStats), FillError> {
+    #[cfg(feature = "tetgen")]
+    {
+        fill_core_with(&tetgen::TetGen::default(), layers, wall, options)
+    }
+    #[cfg(not(feature = "tetgen"))]
+    {
+        let _ = (layers, wall, options);
+        Err(FillError::NoMesher)
+    }
+}
+
+/// Fill the core of `layers` (built by [`crate::layers::build_layers`] from `wall` exactly as
+/// that got it: validated, and flipped for internal flow; its points are the mesh's first
+/// points) and return the whole mesh: the layer cells, the pyramids on the front
+/// quads and the core tetrahedra (zone [`CORE_ZONE_NAME`]); boundary patches are the wall's and
+/// [`FARFIELD_PATCH`] (the layers' top faces are interior now).
+pub fn fill_core_with(
+    mesher: &dyn CoreMesher,
+    layers: &VolumeMesh,
+    wall: &Surface,
+    options: &CoreOptions,
+) -> Result<(VolumeMesh, CoreStats), FillError> {
+    let start = Instant::now();
+    let mut core = front::core_boundary(layers, wall)?;
+    if let Some(spec) = &options.farfield {
+        core.add_farfield(wall, spec)?;
+    }
+    let (boundary, nodes) = core.closed_boundary();
+    let sizing = PointSizing::mean_edge_length(&boundary);
+    let mesher_start = Instant::now();
+    let tets = mesher.fill(&boundary, &sizing)?;
+    let mesher_seconds = mesher_start.elapsed().as_secs_f64();
+    merge::check_boundary_kept(&boundary, &tets)?;
+    let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
+    stats.boundary_steiner_points = tets.boundary_steiner_points;
+    stats.mesher_seconds = mesher_seconds;
+    stats.seconds = start.elapsed().as_secs_f64();
+    Ok((mesh, stats))
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,182 @@
+use super::*;
+use crate::geometry::predicates::{orient3d, Sign};
+use crate::layers::{LAYER_ZONE_NAME, TOP_PATCH};
+use crate::quality;
+use crate::surface::shapes;
+
+/// The "layered mesh" of a wall without layers: its points, no cells, no top faces.
+fn bare_wall(wall: &Surface) -> VolumeMesh {
+    let mut patch_names = wall.patch_names.clone();
+    patch_names.push(TOP_PATCH.to_owned());
+    VolumeMesh {
+        points: wall.points.clone(),
+        zone_names: vec![LAYER_ZONE_NAME.to_owned()],
+        patch_names,
+        ..Default::default()
+    }
+}
+
+/// A surface as a boundary, every triangle marked as wall.
+fn boundary_of(s: &Surface) -> ClosedBoundary {
+    ClosedBoundary {
+        points: s.points.clone(),
+        triangles: s.triangles.clone(),
+        markers: vec![MARKER_WALL; s.triangles.len()],
+    }
+}
+
+#[test]
+fn hole_points_lie_inside_bodies_only() {
+    let cube = shapes::cuboid(DVec3::splat(1.0), 2);
+    let boundary = boundary_of(&cube);
+    let mut with_farfield = boundary.clone();
+    let far = farfield::farfield(&FarfieldSpec::default(), cube.bounding_box()).unwrap();
+    let offset = with_farfield.points.len() as u32;
+    with_farfield.points.extend(far.points);
+    with_farfield.triangles.extend(far.triangles.iter().map(|t| t.map(|v| v + offset)));
+    with_farfield.markers.resize(with_farfield.triangles.len(), MARKER_FARFIELD);
+    let holes = with_farfield.hole_points().unwrap();
+    assert_eq!(holes.len(), 1);
+    assert!(holes[0].cmpgt(DVec3::ZERO).all() && holes[0].cmplt(DVec3::ONE).all(), "{:?}", holes[0]);
+    // The body shell facing inward bounds the region from outside: no hole.
+    let mut inward = boundary.clone();
+    inward.triangles.iter_mut().for_each(|t| t.swap(1, 2));
+    assert!(inward.hole_points().unwrap().is_empty());
+    // Alone, the body shell leaves the region unbounded.
+    assert!(matches!(boundary.hole_points(), Err(FillError::Input(_))));
+}
+
+#[test]
+fn sizing_is_the_mean_edge_length() {
+    let cube = shapes::cuboid(DVec3::splat(2.0), 1);
+    let boundary = boundary_of(&cube);
+    let sizing = PointSizing::mean_edge_length(&boundary);
+    // Every edge is 2 or 2 sqrt(2) long; each corner's mean lies between.
+    assert!(sizing.size.iter().all(|&s| s > 2.0 && s < 2.0 * 2f64.sqrt()), "{:?}", sizing.size);
+}
+
+#[test]
+fn pyramid_apex_is_above_the_quad_and_lower_when_needed() {
+    let square = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+    let apex = front::pyramid_apex(square).unwrap();
+    assert!((apex - DVec3::new(0.5, 0.5, 0.5)).length() < 1e-12, "{apex:?}");
+    // A flat (zero-area) quad has no valid pyramid.
+    let flat = [DVec3::ZERO, DVec3::X, DVec3::X, DVec3::ZERO];
+    assert!(front::pyramid_apex(flat).is_none());
+}
+
+#[test]
+fn a_wall_that_is_not_the_meshes_is_rejected() {
+    let cube = shapes::cuboid(DVec3::splat(1.0), 2);
+    let mut other = cube.clone();
+    other.points[0].x += 0.1;
+    let r = fill_core(&bare_wall(&other), &cube, &CoreOptions::default());
+    assert!(matches!(r, Err(FillError::WallMismatch(_))), "{r:?}");
+}
+
+/// A cube with no layers in a box farfield: the core alone, valid, its volume the box's minus
+/// the cube's, and every wall triangle a face of exactly one tetrahedron.
+#[cfg(feature = "tetgen")]
+#[test]
+fn cube_in_a_box_without_layers() {
+    let wall = shapes::cuboid(DVec3::splat(1.0), 4);
+    let options = CoreOptions { farfield: Some(FarfieldSpec { factor: 4.0, ..Default::default() }) };
+    let (mesh, stats) = fill_core(&bare_wall(&wall), &wall, &options).unwrap();
+    let check = quality::check(&mesh);
+    assert!(check.is_valid(), "{check}");
+    let side = 4.0 * 3f64.sqrt();
+    let expected = side.powi(3) - 1.0;
+    assert!((check.volume.cells - expected).abs() < 1e-9 * expected, "{} vs {expected}", check.volume.cells);
+    assert_eq!(stats.boundary_steiner_points, 0);
+    assert_eq!(stats.pyramids, 0);
+    assert!(stats.tetrahedra > 0 && stats.min_dihedral > 0.0);
+    assert_eq!(mesh.patch_names, ["xmin", "xmax", "ymin", "ymax", "zmin", "zmax", FARFIELD_PATCH]);
+    assert_eq!(mesh.zone_names, [LAYER_ZONE_NAME, CORE_ZONE_NAME]);
+    // Wall faces point into the body; the tetrahedron on each lies on the fluid side.
+    for (t, [a, b, c]) in wall.triangles.iter().enumerate() {
+        let on = mesh
+            .block(crate::mesh::CellKind::Tetrahedron)
+            .iter()
+            .filter(|tet| [a, b, c].iter().all(|v| tet.contains(v)));
+        let tets: Vec<&[u32]> = on.collect();
+        assert_eq!(tets.len(), 1, "wall triangle {t}");
+        let d = tets[0].iter().find(|v| ![a, b, c].contains(v)).unwrap();
+        let p = |v: u32| mesh.points[v as usize];
+        assert_eq!(orient3d(p(*a), p(*b), p(*c), p(*d)), Sign::Positive);
+    }
+    eprintln!("cube without layers: {stats:?}");
+}
+
+mod properties {
+    use proptest::prelude::*;
+
+    use super::*;
+    use crate::mesh::CellKind;
+    use crate::quality::validity::cell_validity;
+
+    proptest! {
+        /// Whatever the quad, a pyramid is only ever proposed valid.
+        #[test]
+        fn proposed_pyramids_are_valid(coords in proptest::collection::vec(-1.0f64..1.0, 12)) {
+            let x: Vec<DVec3> = coords.chunks(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
+            if let Some(apex) = front::pyramid_apex([x[0], x[1], x[2], x[3]]) {
+                let mut p = [DVec3::ZERO; 8];
+                p[..4].copy_from_slice(&x);
+                p[4] = apex;
+                prop_assert!(cell_validity(CellKind::Pyramid, &p).is_valid());
+            }
+        }
+    }
+
+    #[cfg(feature = "tetgen")]
+    proptest! {
+        #![proptest_config(ProptestConfig { cases: 8, ..ProptestConfig::default() })]
+        /// Boxes of any proportions, resolution and farfield: a valid mesh of the right volume.
+        #[test]
+        fn any_box_in_any_farfield_fills_validly(
+            size in (0.05f64..20.0, 0.05f64..20.0, 0.05f64..20.0),
+            n in 1usize..4,
+            factor in 2.0f64..40.0,
+            sphere in any::<bool>(),
+        ) {
+            let wall = shapes::cuboid(DVec3::new(size.0, size.1, size.2), n);
+            let shape = if sphere { crate::config::FarfieldShape::Sphere } else { crate::config::FarfieldShape::Box };
+            let spec = FarfieldSpec { shape, factor, cell_size: None };
+            let options = CoreOptions { farfield: Some(spec) };
+            let (mesh, stats) = fill_core(&bare_wall(&wall), &wall, &options).unwrap();
+            let check = quality::check(&mesh);
+            prop_assert!(check.is_valid(), "{}", check);
+            let far = farfield::farfield(&spec, wall.bounding_box()).unwrap();
+            let expected = -far.enclosed_volume() - wall.enclosed_volume();
+            prop_assert!((check.volume.cells - expected).abs() <= 1e-9 * expected);
+            prop_assert_eq!(stats.boundary_steiner_points, 0);
+        }
+    }
+}
+
+#[test]
+fn broken_boundaries_are_errors_not_crashes() {
+    let cube = shapes::cuboid(DVec3::splat(1.0), 1);
+    let good = boundary_of(&cube);
+    good.check_structure().unwrap();
+    let mut out_of_range = good.clone();
+    out_of_range.triangles[3][1] = 99;
+    let mut nan = good.clone();
+    nan.points[2].y = f64::NAN;
+    let mut flat = good.clone();
+    flat.triangles[0] = [0, 1, 1];
+    let mut unmarked = good.clone();
+    unmarked.markers.pop();
+    for broken in [out_of_range, nan, flat, unmarked] {
+        assert!(matches!(broken.check_structure(), Err(FillError::Input(_))));
+        assert!(broken.hole_points().is_err() && broken.check_no_self_intersection().is_err());
+    }
+    // A cube crossing another one is reported before any mesher sees it.
+    let mut crossing = good.clone();
+    let offset = crossing.points.len() as u32;
+    crossing.points.extend(cube.points.iter().map(|p| *p + DVec3::splat(0.5)));
+    crossing.triangles.extend(cube.triangles.iter().map(|t| t.map(|v| v + offset)));
+    crossing.markers.resize(24, MARKER_FRONT);
+    let e = crossing.check_no_self_intersection().unwrap_err();
+    assert!(matches!(e, FillError::SelfIntersecting { .. }), "{e}");
+}

@@ -1,0 +1,289 @@
+//! [`CoreMesher`] through TetGen 1.5 (system library `libtet`, C++ shim `csrc/tetgen_shim.cpp`).
+//!
+//! Switches (TetGen 1.5 manual, section 4.2; `tetgenbehavior::parse_commandline`):
+//! - `p`: the input is a piecewise linear complex (our boundary triangles, one facet each);
+//! - `Y`: keep the boundary mesh: no Steiner point on a boundary triangle or edge, so the front
+//!   triangles stay faces of the tetrahedra exactly;
+//! - `M`: do not merge coplanar neighbouring facets (merging flips their triangles' diagonals);
+//! - `z`: number from zero; `Q`: quiet;
+//! - `q{ratio}/{angle}`: Delaunay refinement until no tetrahedron has a radius-edge ratio above
+//!   `ratio` or a dihedral angle below `angle` (where the boundary allows it);
+//! - `m`: the size at every boundary point (`pointmtrlist`): a tetrahedron is split while its
+//!   circumradius exceeds the size at one of its nodes; added points interpolate the sizes;
+//! - `O{level}/7`: mesh optimisation after refinement (flips, smoothing of added points, point
+//!   insertion/deletion), `level` passes.
+//!
+//! Hole points (`holelist`) inside the body shells make TetGen carve the body's interior.
+//! TetGen keeps global state, so calls are serialised.
+
+use std::ffi::{c_char, c_int, CString};
+use std::sync::Mutex;
+
+use super::{ClosedBoundary, CoreMesher, CoreTets, FillError, PointSizing};
+use crate::geometry::predicates::{orient3d, Sign};
+use crate::geometry::DVec3;
+
+/// Circumradius of a regular tetrahedron over its edge length, sqrt(6)/4: TetGen's `-m` bounds
+/// circumradii, the sizing gives edge lengths.
+const CIRCUMRADIUS_PER_EDGE: f64 = 0.612_372_435_695_794_5;
+
+/// TetGen with its quality and optimisation settings.
+#[derive(Clone, Debug, PartialEq)]
+pub struct TetGen {
+    /// Largest radius-edge ratio of a tetrahedron (`-q`), >= 1.
+    pub radius_edge: f64,
+    /// Smallest dihedral angle refinement aims at, degrees (`-q.../angle`).
+    pub min_dihedral: f64,
+    /// Optimisation passes (`-O`), 0..=9.
+    pub optimisation: u8,
+}
+
+impl Default for TetGen {
+    fn default() -> Self {
+        TetGen { radius_edge: 1.4, min_dihedral: 18.0, optimisation: 9 }
+    }
+}
+
+impl TetGen {
+    /// The switch string for a run with (`sized`) or without per-point sizes.
+    pub fn switches(&self, sized: bool) -> String {
+        let radius_edge = self.radius_edge.max(1.0);
+        let angle = self.min_dihedral.clamp(0.0, 60.0);
+        let level = self.optimisation.min(9);
+        format!("pYMzQq{radius_edge:.4}/{angle:.4}O{level}/7{}", if sized { "m" } else { "" })
+    }
+}
+
+impl CoreMesher for TetGen {
+    fn fill(&self, boundary: &ClosedBoundary, sizing: &PointSizing) -> Result<CoreTets, FillError> {
+        let sized = !sizing.size.is_empty();
+        if sized && sizing.size.len() != boundary.points.len() {
+            return Err(FillError::Input(format!(
+                "{} sizes for {} points",
+                sizing.size.len(),
+                boundary.points.len()
+            )));
+        }
+        let radii: Vec<f64> = sizing.size.iter().map(|s| s * CIRCUMRADIUS_PER_EDGE).collect();
+        let input = Input::new(boundary, sized.then_some(&radii[..]))?;
+        let output = run(&input, &self.switches(sized))?;
+        output.into_core(boundary.points.len())
+    }
+}
+
+/// The boundary as TetGen's C arrays, checked.
+struct Input {
+    points: Vec<f64>,
+    sizes: Option<Vec<f64>>,
+    triangles: Vec<c_int>,
+    markers: Vec<c_int>,
+    holes: Vec<f64>,
+}
+
+impl Input {
+    fn new(boundary: &ClosedBoundary, sizes: Option<&[f64]>) -> Result<Input, FillError> {
+        let fits = |count: usize, what: &str| {
+            c_int::try_from(count)
+                .map_err(|_| FillError::Input(format!("{count} {what} are too many for TetGen")))
+        };
+        fits(boundary.points.len(), "points")?;
+        fits(boundary.triangles.len(), "triangles")?;
+        if let Some(p) = sizes.and_then(|s| s.iter().position(|x| !(x.is_finite() && *x >= 0.0))) {
+            return Err(FillError::Input(format!("the size at point {p} is not a length")));
+        }
+        // TetGen may crash (not fail) on a boundary that intersects itself.
+        boundary.check_no_self_intersection()?;
+        let holes = boundary.hole_points()?;
+        Ok(Input {
+            points: boundary.points.iter().flat_map(|p| p.to_array()).collect(),
+            sizes: sizes.map(<[f64]>::to_vec),
+            // Node indices are < the point count, which fits c_int.
+            triangles: boundary.triangles.iter().flatten().map(|&v| v as c_int).collect(),
+            markers: boundary.markers.iter().map(|&m| c_int::try_from(m).unwrap_or(c_int::MAX)).collect(),
+            holes: holes.iter().flat_map(|p| p.to_array()).collect(),
+        })
+    }
+}
+
+/// TetGen's output, copied out of the shim.
+struct Output {
+    points: Vec<DVec3>,
+    tets: Vec<[c_int; 4]>,
+    boundary_triangles: Vec<[c_int; 3]>,
+}
+
+impl Output {
+    /// Checked indices, positive orientation, and the count of added boundary points.
+    fn into_core(self, boundary_points: usize) -> Result<CoreTets, FillError> {
+        let n = self.points.len();
+        let index = |v: c_int| usize::try_from(v).ok().filter(|&v| v < n).map(|v| v as u32);
+        let mut tets = Vec::with_capacity(self.tets.len());
+        for (i, tet) in self.tets.iter().enumerate() {
+            let bad = || FillError::BadOutput(format!("TetGen tetrahedron {i} {tet:?} is out of range"));
+            let mut t = [0u32; 4];
+            for (ti, &v) in t.iter_mut().zip(tet) {
+                *ti = index(v).ok_or_else(bad)?;
+            }
+            let [a, b, c, d] = t.map(|v| self.points[v as usize]);
+            match orient3d(a, b, c, d) {
+                Sign::Positive => tets.push(t),
+                Sign::Negative => tets.push([t[1], t[0], t[2], t[3]]),
+                Sign::Zero => {
+                    return Err(FillError::BadOutput(format!("TetGen tetrahedron {i} {t:?} is flat")))
+                }
+            }
+        }
+        let mut added_on_boundary: Vec<usize> = self
+            .boundary_triangles
+            .iter()
+            .flatten()
+            .filter_map(|&v| usize::try_from(v).ok())
+            .filter(|&v| v >= boundary_points)
+            .collect();
+        added_on_boundary.sort_unstable();
+        added_on_boundary.dedup();
+        Ok(CoreTets { points: self.points, tets, boundary_steiner_points: added_on_boundary.len() })
+    }
+}
+
+/// TetGen keeps global state (its predicates' constants, among others): one run at a time.
+static TETGEN: Mutex<()> = Mutex::new(());
+
+mod ffi {
+    use std::ffi::{c_char, c_int};
+
+    /// The shim's opaque result (a `tetgenio`).
+    #[repr(C)]
+    pub struct BlmeshTetgenResult {
+        _private: [u8; 0],
+    }
+
+    extern "C" {
+        #[allow(clippy::too_many_arguments)]
+        pub fn blmesh_tetgen_run(
+            n_points: c_int,
+            points: *const f64,
+            sizes: *const f64,
+            n_triangles: c_int,
+            triangles: *const c_int,
+            markers: *const c_int,
+            n_holes: c_int,
+            holes: *const f64,
+            switches: *const c_char,
+            result: *mut *mut BlmeshTetgenResult,
+            message: *mut c_char,
+            message_capacity: usize,
+        ) -> c_int;
+        pub fn blmesh_tetgen_counts(
+            result: *const BlmeshTetgenResult,
+            n_points: *mut c_int,
+            n_tets: *mut c_int,
+            n_boundary_triangles: *mut c_int,
+        );
+        pub fn blmesh_tetgen_copy(
+            result: *const BlmeshTetgenResult,
+            points: *mut f64,
+            tets: *mut c_int,
+            boundary_triangles: *mut c_int,
+        );
+        pub fn blmesh_tetgen_free(result: *mut BlmeshTetgenResult);
+    }
+}
+
+/// Frees the shim's result however the copy ends.
+struct ResultGuard(*mut ffi::BlmeshTetgenResult);
+
+impl Drop for ResultGuard {
+    fn drop(&mut self) {
+        // SAFETY: the pointer came from a successful `blmesh_tetgen_run`, is non-null, and is
+        // freed exactly once, here.
+        unsafe { ffi::blmesh_tetgen_free(self.0) }
+    }
+}
+
+fn run(input: &Input, switches: &str) -> Result<Output, FillError> {
+    let switches = CString::new(switches).map_err(|_| FillError::Input("switches contain a NUL".into()))?;
+    let mut result: *mut ffi::BlmeshTetgenResult = std::ptr::null_mut();
+    let mut message = [0 as c_char; 256];
+    let _one_at_a_time = TETGEN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    // SAFETY: every array holds the counts passed with it (checked to fit c_int in Input::new;
+    // triangle indices are < n_points); `sizes` is null or n_points long; `holes` holds 3 values
+    // per hole; the strings are NUL-terminated and `message` has the capacity passed. The shim
+    // catches every C++ exception, so nothing unwinds into Rust.
+    let code = unsafe {
+        ffi::blmesh_tetgen_run(
+            (input.points.len() / 3) as c_int,
+            input.points.as_ptr(),
+            input.sizes.as_ref().map_or(std::ptr::null(), |s| s.as_ptr()),
+            (input.triangles.len() / 3) as c_int,
+            input.triangles.as_ptr(),
+            input.markers.as_ptr(),
+            (input.holes.len() / 3) as c_int,
+            input.holes.as_ptr(),
+            switches.as_ptr(),
+            &mut result,
+            message.as_mut_ptr(),
+            message.len(),
+        )
+    };
+    if code != 0 || result.is_null() {
+        return Err(tetgen_error(code, &message));
+    }
+    let guard = ResultGuard(result);
+    let (mut n_points, mut n_tets, mut n_triangles) = (0 as c_int, 0 as c_int, 0 as c_int);
+    // SAFETY: `guard.0` is a live result; the three out-pointers are valid for writes.
+    unsafe { ffi::blmesh_tetgen_counts(guard.0, &mut n_points, &mut n_tets, &mut n_triangles) };
+    let count = |c: c_int| usize::try_from(c).map_err(|_| FillError::BadOutput(format!("TetGen count {c}")));
+    let (n_points, n_tets, n_triangles) = (count(n_points)?, count(n_tets)?, count(n_triangles)?);
+    let mut points = vec![0.0f64; 3 * n_points];
+    let mut tets = vec![0 as c_int; 4 * n_tets];
+    let mut triangles = vec![0 as c_int; 3 * n_triangles];
+    // SAFETY: the buffers are sized from the counts the shim just reported for this result.
+    unsafe {
+        ffi::blmesh_tetgen_copy(guard.0, points.as_mut_ptr(), tets.as_mut_ptr(), triangles.as_mut_ptr())
+    };
+    drop(guard);
+    Ok(Output {
+        points: points.chunks_exact(3).map(|p| DVec3::new(p[0], p[1], p[2])).collect(),
+        tets: tets.chunks_exact(4).map(|t| [t[0], t[1], t[2], t[3]]).collect(),
+        boundary_triangles: triangles.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect(),
+    })
+}
+
+/// TetGen's error codes (`terminatetetgen`) and the shim's own, explained.
+fn tetgen_error(code: c_int, message: &[c_char]) -> FillError {
+    let bytes: Vec<u8> = message.iter().take_while(|&&c| c != 0).map(|&c| c as u8).collect();
+    let detail = String::from_utf8_lossy(&bytes);
+    let meaning = match code {
+        1 => "out of memory",
+        2 => "internal error",
+        3 => "the boundary intersects itself (the front crosses itself or the farfield)",
+        4 => "a very small input feature (points or edges too close for the tolerance)",
+        5 => "two boundary triangles are very close to each other",
+        10 => "input error",
+        100 => "bad arguments to the shim",
+        101 | 102 => "C++ exception",
+        _ => "unknown error",
+    };
+    FillError::TetGen { code, message: format!("{meaning}; {detail}") }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn switches_keep_the_boundary_and_bound_the_quality() {
+        let s = TetGen::default().switches(true);
+        assert!(s.starts_with("pYMzQq1.4000/18.0000O9/7"), "{s}");
+        assert!(s.ends_with('m'));
+        assert!(!TetGen::default().switches(false).contains('m'));
+    }
+
+    #[test]
+    fn error_codes_are_explained() {
+        let msg: Vec<c_char> = b"TetGen stopped\0".iter().map(|&b| b as c_char).collect();
+        let e = tetgen_error(3, &msg).to_string();
+        assert!(e.contains("intersects itself") && e.contains("TetGen stopped"), "{e}");
+    }
+}
