@@ -93,6 +93,9 @@ struct MeshArgs {
     /// Also write the run's report as JSON.
     #[arg(long)]
     report: Option<PathBuf>,
+    /// Also write pictures (PNG) of cuts through the mesh and a quality histogram into DIR.
+    #[arg(long, value_name = "DIR")]
+    pictures: Option<PathBuf>,
 }
 
 /// Run the command line; returns the process exit code.
@@ -174,6 +177,10 @@ fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
         let text = serde_json::to_string_pretty(&out.report)?;
         io::write_atomic(report_path, |w| w.write_all(text.as_bytes()))
             .with_context(|| format!("{}: cannot write", report_path.display()))?;
+    }
+    if let Some(dir) = &args.pictures {
+        crate::picture::write_overview(&out.mesh, dir)
+            .with_context(|| format!("{}: cannot write the pictures", dir.display()))?;
     }
     if !quiet {
         print_out(&out.report.to_string());

@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use crate::config::{Config, ConfigError, Flow, LayerCount, LayerSpec};
+use crate::fill::{fill_core, CoreOptions, CoreStats, FillError};
 use crate::layers::{self, MarchStats};
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::normals::{self, NormalStats};
@@ -17,7 +18,8 @@ use crate::surface::Surface;
 /// Options of a run that are not meshing parameters.
 #[derive(Clone, Debug)]
 pub struct MeshOptions {
-    /// Fill the core with tetrahedra (not available yet: the layers are written alone).
+    /// Fill the core with tetrahedra up to the farfield (or, for internal flow, the whole
+    /// inside); otherwise the mesh holds the layers alone, their top faces as a patch.
     pub core: bool,
 }
 
@@ -29,6 +31,8 @@ pub enum MeshError {
     Config(#[from] ConfigError),
     #[error("{0}")]
     Unsupported(String),
+    #[error("core fill failed: {0} (the layers alone can be written with --no-core)")]
+    Fill(#[from] FillError),
     #[error("the mesh failed its own check (a bug in blmesh; please report it):\n{0}")]
     InvalidResult(Box<CheckReport>),
 }
@@ -46,7 +50,8 @@ pub struct MeshReport {
     pub features: FeatureCounts,
     pub normals: NormalStats,
     pub layers: LayerSummary,
-    pub core: &'static str,
+    /// The core fill, when it was run.
+    pub core: Option<CoreStats>,
     pub cells: CellCounts,
     pub check: CheckReport,
     pub timings: Timings,
@@ -130,13 +135,15 @@ pub fn run(
         })
     });
     bar.finish_and_clear();
-    let core = if options.core {
-        warnings.push("core fill is not implemented yet: the mesh holds the layers only".into());
-        "not built (not implemented yet)"
+    let layer_summary = layer_summary(&layered, &surface);
+    let (mesh, core) = if options.core {
+        let (mesh, stats) =
+            timings.time("core", || fill_core(&layered.mesh, &surface, &CoreOptions::from_config(config)))?;
+        (mesh, Some(stats))
     } else {
-        "not requested (--no-core)"
+        (layered.mesh, None)
     };
-    let check = timings.time("check", || quality::check(&layered.mesh));
+    let check = timings.time("check", || quality::check(&mesh));
     if !check.is_valid() {
         return Err(MeshError::InvalidResult(Box::new(check)));
     }
@@ -149,15 +156,15 @@ pub fn run(
         },
         features: features.counts.clone(),
         normals: wall_normals.stats.clone(),
-        layers: layer_summary(&layered, &surface),
+        layers: layer_summary,
         core,
-        cells: CellCounts::of(&layered.mesh),
+        cells: CellCounts::of(&mesh),
         check,
         timings,
         peak_memory_mib: crate::progress::peak_memory_mib(),
         warnings,
     };
-    Ok(MeshOutput { mesh: layered.mesh, report })
+    Ok(MeshOutput { mesh, report })
 }
 
 /// The resolved layer stack of every patch (`None`: no layers on it).
@@ -244,7 +251,14 @@ impl std::fmt::Display for MeshReport {
             self.normals.fan_edges,
             self.normals.corner_patches
         )?;
-        writeln!(f, "core      {}", self.core)?;
+        match &self.core {
+            Some(c) => writeln!(
+                f,
+                "core      {} tetrahedra ({} pyramids on front quads), dihedral {:.1}..{:.1} deg, {} boundary points added",
+                c.tetrahedra, c.pyramids, c.min_dihedral, c.max_dihedral, c.boundary_steiner_points
+            )?,
+            None => writeln!(f, "core      not built (--no-core): the layers' top faces are the patch bl_top")?,
+        }
         writeln!(f, "quality   worst scaled Jacobian {:.3}", worst_scaled_jacobian(&self.check))?;
         for w in &self.warnings {
             writeln!(f, "warning   {w}")?;

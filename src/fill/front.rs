@@ -5,15 +5,10 @@ use std::collections::HashSet;
 
 use super::{farfield, ClosedBoundary, FarfieldSpec, FillError, CORE_ZONE_NAME, FARFIELD_PATCH};
 use super::{sorted_triangle, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
-use crate::geometry::DVec3;
 use crate::layers::TOP_PATCH;
 use crate::mesh::{BoundaryFaces, CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
-use crate::quality::validity::cell_validity;
 use crate::surface::Surface;
-
-/// Apex heights tried for a pyramid on a front quad: half its mean edge length, then halved.
-const APEX_TRIES: i32 = 6;
 
 /// The mesh being built around the core: the layered mesh without its top faces plus the
 /// pyramids and the farfield, and the core's boundary triangles (mesh node ids, facing into
@@ -115,7 +110,8 @@ impl CoreBuild {
     fn add_pyramid(&mut self, quad: [u32; 4]) -> Result<(), FillError> {
         let x = quad.map(|n| self.mesh.points[n as usize]);
         let centre = quad_centre(x[0], x[1], x[2], x[3]);
-        let apex = pyramid_apex(x).ok_or(FillError::NoPyramid { nodes: quad, centre: centre.to_array() })?;
+        let apex = crate::layers::guard::pyramid_apex(x)
+            .ok_or(FillError::NoPyramid { nodes: quad, centre: centre.to_array() })?;
         let apex_node = self.mesh.points.len() as u32;
         self.mesh.points.push(apex);
         let [a, b, c, d] = quad;
@@ -168,18 +164,4 @@ impl CoreBuild {
         let points = nodes.iter().map(|&n| self.mesh.points[n as usize]).collect();
         (ClosedBoundary { points, triangles, markers: self.markers.clone() }, nodes)
     }
-}
-
-/// The apex of a valid pyramid on the quad `x` (its right-hand normal pointing to the apex):
-/// above the quad's centre at half its mean edge length, or lower where that is invalid.
-pub(super) fn pyramid_apex(x: [DVec3; 4]) -> Option<DVec3> {
-    let centre = quad_centre(x[0], x[1], x[2], x[3]);
-    let normal = (x[2] - x[0]).cross(x[3] - x[1]).normalize_or_zero();
-    let mean_edge = (0..4).map(|i| x[i].distance(x[(i + 1) % 4])).sum::<f64>() / 4.0;
-    (0..APEX_TRIES).map(|k| centre + normal * (0.5 * mean_edge * 0.5f64.powi(k))).find(|&apex| {
-        let mut p = [DVec3::ZERO; 8];
-        p[..4].copy_from_slice(&x);
-        p[4] = apex;
-        cell_validity(CellKind::Pyramid, &p).is_valid()
-    })
 }

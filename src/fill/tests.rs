@@ -58,11 +58,11 @@ fn sizing_is_the_mean_edge_length() {
 #[test]
 fn pyramid_apex_is_above_the_quad_and_lower_when_needed() {
     let square = [DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
-    let apex = front::pyramid_apex(square).unwrap();
+    let apex = crate::layers::guard::pyramid_apex(square).unwrap();
     assert!((apex - DVec3::new(0.5, 0.5, 0.5)).length() < 1e-12, "{apex:?}");
     // A flat (zero-area) quad has no valid pyramid.
     let flat = [DVec3::ZERO, DVec3::X, DVec3::X, DVec3::ZERO];
-    assert!(front::pyramid_apex(flat).is_none());
+    assert!(crate::layers::guard::pyramid_apex(flat).is_none());
 }
 
 #[test]
@@ -119,7 +119,7 @@ mod properties {
         #[test]
         fn proposed_pyramids_are_valid(coords in proptest::collection::vec(-1.0f64..1.0, 12)) {
             let x: Vec<DVec3> = coords.chunks(3).map(|c| DVec3::new(c[0], c[1], c[2])).collect();
-            if let Some(apex) = front::pyramid_apex([x[0], x[1], x[2], x[3]]) {
+            if let Some(apex) = crate::layers::guard::pyramid_apex([x[0], x[1], x[2], x[3]]) {
                 let mut p = [DVec3::ZERO; 8];
                 p[..4].copy_from_slice(&x);
                 p[4] = apex;

@@ -15,6 +15,7 @@ use rayon::prelude::*;
 use super::collapse::Merges;
 use super::entropy;
 use super::front::{Columns, Front};
+use super::guard;
 use super::slab::{slab_cell, Polygon, SlabCell};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -193,9 +194,9 @@ pub fn march(
     stats
 }
 
-/// Decide which columns move and merge so that every cell of the slab is valid.
+/// Decide which columns move and merge so that every cell of the slab is valid and the new
+/// front does not cross itself.
 fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Vec<DVec3>) -> SlabPlan {
-    let committed = mesh.points.len() as u32;
     let mut plan = SlabPlan {
         moving: columns.alive.clone(),
         proposed,
@@ -204,10 +205,39 @@ fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Ve
         collapses: 0,
     };
     let mut to_check: Vec<usize> = (0..front.len()).collect();
+    loop {
+        repair_invalid_cells(&mut plan, mesh, columns, front, to_check);
+        let crossing = guard::crossing_faces(&plan, mesh, columns, front);
+        let mut changed = Vec::new();
+        for f in crossing {
+            tracing::debug!(face = f, "the new front crosses itself: stopping the face's columns");
+            for &c in front.face_columns(f) {
+                if plan.moving[plan.merges.root(c) as usize] {
+                    changed.extend(plan.stop(c));
+                }
+            }
+        }
+        if changed.is_empty() {
+            return plan;
+        }
+        to_check = front.faces_around_columns(&changed);
+    }
+}
+
+/// Check the cells over `to_check` and repair the invalid ones (a collapse where the cell is
+/// being crushed, else stopping its columns) until every cell is valid.
+fn repair_invalid_cells(
+    plan: &mut SlabPlan,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    mut to_check: Vec<usize>,
+) {
+    let committed = mesh.points.len() as u32;
     while !to_check.is_empty() {
         let invalid: Vec<usize> = {
             let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-            let plan = &plan;
+            let plan = &*plan;
             to_check
                 .par_iter()
                 .copied()
@@ -219,46 +249,11 @@ fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Ve
         };
         let mut changed = Vec::new();
         for &f in &invalid {
-            if let Some(merged) = entropy::collapse_crushed_edge(&mut plan, front, f, columns, &mesh.points) {
+            if let Some(merged) = entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points) {
                 changed.extend(merged);
                 continue;
             }
-            if tracing::enabled!(tracing::Level::DEBUG) {
-                let (b, t, n) = face_nodes(front, f, &plan, columns, committed);
-                let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-                let cols: Vec<String> = front
-                    .face_columns(f)
-                    .iter()
-                    .map(|&c| {
-                        let c = c as usize;
-                        format!(
-                            "c{c} v{} s{:.3} d{:.3?}",
-                            columns.wall_vertex[c],
-                            columns.scale[c],
-                            columns.dir[c].to_array()
-                        )
-                    })
-                    .collect();
-                let ratios: Vec<String> = (0..n)
-                    .map(|i| {
-                        let (x, y) = (b[i], b[(i + 1) % n]);
-                        let (tx, ty) = (t[i], t[(i + 1) % n]);
-                        format!(
-                            "{:.3}",
-                            super::entropy::shrink_ratio(
-                                proposal.position(x),
-                                proposal.position(y),
-                                proposal.position(tx),
-                                proposal.position(ty)
-                            )
-                        )
-                    })
-                    .collect();
-                tracing::debug!(
-                    "invalid cell over face {f}: {:?}; ratios {ratios:?}; {cols:?}",
-                    slab_cell(&b[..n], &t[..n])
-                );
-            }
+            tracing::debug!(face = f, columns = ?front.face_columns(f), "invalid cell: stopping its columns");
             for &c in front.face_columns(f) {
                 if plan.moving[plan.merges.root(c) as usize] {
                     changed.extend(plan.stop(c));
@@ -268,7 +263,6 @@ fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Ve
         // Only the cells around a column that stopped or merged can change.
         to_check = front.faces_around_columns(&changed);
     }
-    plan
 }
 
 /// Create the nodes of the moving columns, emit the slab's cells and apply the merges.

@@ -7,6 +7,7 @@
 pub mod collapse;
 pub mod entropy;
 pub mod front;
+pub mod guard;
 pub mod march;
 pub mod slab;
 

@@ -7,6 +7,7 @@
 
 mod conformity;
 pub mod measures;
+pub mod overlap;
 mod report;
 pub mod samples;
 pub mod validity;
@@ -42,6 +43,7 @@ pub fn check(mesh: &VolumeMesh) -> CheckReport {
     report.conformity = conformity;
     report.volume =
         VolumeCheck { cells: volume, enclosed, relative_difference: relative_difference(volume, enclosed) };
+    report.overlap = overlap::boundary_overlap(mesh);
     report.unused_points = count_unused_points(mesh);
     if report.unused_points > 0 {
         report.warnings.push(format!("{} points are used by no cell", report.unused_points));

@@ -286,6 +286,8 @@ pub struct CheckReport {
     pub validity: Validity,
     pub conformity: Conformity,
     pub volume: VolumeCheck,
+    /// The boundary crossing itself: cells folded over each other.
+    pub overlap: super::overlap::Overlap,
     /// Quality of the cells whose nodes are in range (invalid cells included).
     pub quality: PerKind<KindQuality>,
 }
@@ -307,6 +309,7 @@ impl CheckReport {
             && self.structure_errors.is_empty()
             && self.validity.invalid_cells == 0
             && self.conformity.errors == 0
+            && self.overlap.intersecting_pairs == 0
             && self.volume_identity_holds()
     }
 }
@@ -334,6 +337,19 @@ impl fmt::Display for CheckReport {
              ({verdict})",
             v.cells, v.enclosed, v.relative_difference
         )?;
+        let o = &self.overlap;
+        if o.intersecting_pairs == 0 {
+            writeln!(f, "overlap: none (the boundary does not cross itself)")?;
+        } else {
+            writeln!(
+                f,
+                "overlap: the boundary crosses itself at {} pairs of faces: cells fold over each other",
+                o.intersecting_pairs
+            )?;
+            for [a, b] in o.examples.iter().take(EXAMPLES) {
+                writeln!(f, "  faces at {} and {}", point(a), point(b))?;
+            }
+        }
         write_quality(&self.quality, f)?;
         writeln!(f, "{}", if self.is_valid() { "VALID" } else { "INVALID" })
     }
