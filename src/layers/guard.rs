@@ -1,7 +1,8 @@
 //! The new front must not cross itself: each cell of a slab can be valid while two parts of the
 //! front pass through each other (fronts meeting at a concave ridge, across a thin gap, or a fan
 //! sweeping over its neighbours). The proposed front is tested with the same exact triangle
-//! tests as the input surface.
+//! tests as the input surface; faces sharing a vertex are left to the cells' validity test,
+//! which sees any fold between neighbours.
 
 use glam::DVec3;
 
@@ -11,16 +12,18 @@ use super::slab::Polygon;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
 use crate::quality::validity::cell_validity;
-use crate::surface::validate::intersecting_pairs;
+use crate::surface::validate::intersecting_pairs_with;
 use crate::surface::Surface;
 
 /// The faces of the proposed front that cross another face of it, its quads taken with the
 /// pyramid the core fill will cap them with; and the quads that no pyramid can cap.
+/// Only `suspects` are tested against the rest: the faces whose top moved since the last test.
 pub(super) fn crossing_faces(
     plan: &SlabPlan,
     mesh: &VolumeMesh,
     columns: &Columns,
     front: &Front,
+    suspects: &[usize],
 ) -> Vec<usize> {
     let committed = mesh.points.len() as u32;
     let mut points = mesh.points.clone();
@@ -29,6 +32,10 @@ pub(super) fn crossing_faces(
     let mut triangles = Vec::with_capacity(front.len() * 2);
     let mut owner = Vec::with_capacity(front.len() * 2);
     let mut uncappable = Vec::new();
+    let mut suspect = vec![false; front.len()];
+    for &f in suspects {
+        suspect[f] = true;
+    }
     for f in 0..front.len() {
         let top: Vec<u32> = front
             .face_columns(f)
@@ -51,7 +58,9 @@ pub(super) fn crossing_faces(
         }
         // A quad is seen as the core fill will see it: capped by a pyramid.
         let Some(apex) = pyramid_apex([0, 1, 2, 3].map(|i| points[n[i] as usize])) else {
-            uncappable.push(f);
+            if suspect[f] {
+                uncappable.push(f);
+            }
             continue;
         };
         let a = points.len() as u32;
@@ -64,7 +73,8 @@ pub(super) fn crossing_faces(
     let count = triangles.len();
     let surface =
         Surface { points, triangles, triangle_patch: vec![0; count], patch_names: vec!["front".into()] };
-    let mut faces: Vec<usize> = intersecting_pairs(&surface)
+    let moved: Vec<u32> = (0..count as u32).filter(|&t| suspect[owner[t as usize]]).collect();
+    let mut faces: Vec<usize> = intersecting_pairs_with(&surface, &moved, true)
         .into_iter()
         .flat_map(|(a, b)| [owner[a as usize], owner[b as usize]])
         .collect();

@@ -205,9 +205,13 @@ fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Ve
         collapses: 0,
     };
     let mut to_check: Vec<usize> = (0..front.len()).collect();
+    // Two faces that do not move cannot start to cross: only moving ones are suspects.
+    let mut suspects: Vec<usize> = (0..front.len())
+        .filter(|&f| front.face_columns(f).iter().any(|&c| plan.moving[c as usize]))
+        .collect();
     loop {
         repair_invalid_cells(&mut plan, mesh, columns, front, to_check);
-        let crossing = guard::crossing_faces(&plan, mesh, columns, front);
+        let crossing = guard::crossing_faces(&plan, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
         for f in crossing {
             tracing::debug!(face = f, "the new front crosses itself: stopping the face's columns");
@@ -221,6 +225,7 @@ fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Ve
             return plan;
         }
         to_check = front.faces_around_columns(&changed);
+        suspects = to_check.clone();
     }
 }
 

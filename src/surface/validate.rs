@@ -14,7 +14,7 @@ use std::time::Instant;
 
 use rayon::prelude::*;
 use rstar::primitives::{GeomWithData, Rectangle};
-use rstar::{RTree, AABB};
+use rstar::RTree;
 
 use super::topology::{FanScratch, Topology};
 use super::Surface;
@@ -486,30 +486,41 @@ fn duplicate_triangles(triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
 /// All intersecting pairs (a < b): an R-tree of the triangles' boxes proposes the pairs whose
 /// boxes touch, the exact tests decide (see [`triangle_pair_intersects`]).
 pub fn intersecting_pairs(surface: &Surface) -> Vec<(u32, u32)> {
-    let boxes: Vec<GeomWithData<Rectangle<[f64; 3]>, u32>> = (0..surface.triangles.len())
-        .map(|t| {
-            let b = Aabb::from_points(&surface.triangle_points(t));
-            GeomWithData::new(Rectangle::from_corners(b.min.to_array(), b.max.to_array()), t as u32)
-        })
-        .collect();
+    let all: Vec<u32> = (0..surface.triangles.len() as u32).collect();
+    intersecting_pairs_with(surface, &all, false)
+}
+
+/// The intersecting pairs (a < b) in which at least one triangle is in `queries`; with
+/// `distant_only`, pairs of triangles sharing a vertex are not tested (a caller that knows its
+/// neighbouring triangles are consistent saves most of the exact tests).
+pub fn intersecting_pairs_with(surface: &Surface, queries: &[u32], distant_only: bool) -> Vec<(u32, u32)> {
+    let bounds = |t: usize| {
+        let b = Aabb::from_points(&surface.triangle_points(t));
+        Rectangle::from_corners(b.min.to_array(), b.max.to_array())
+    };
+    let boxes: Vec<GeomWithData<Rectangle<[f64; 3]>, u32>> =
+        (0..surface.triangles.len()).map(|t| GeomWithData::new(bounds(t), t as u32)).collect();
     let tree = RTree::bulk_load(boxes);
-    let mut pairs: Vec<(u32, u32)> = tree
-        .iter()
-        .collect::<Vec<_>>()
-        .into_par_iter()
-        .flat_map_iter(|a| {
-            tree.locate_in_envelope_intersecting(&envelope(a))
-                .filter(|b| b.data > a.data && triangle_pair_intersects(surface, a.data, b.data))
-                .map(|b| (a.data, b.data))
+    let mut pairs: Vec<(u32, u32)> = queries
+        .par_iter()
+        .flat_map_iter(|&a| {
+            let envelope = rstar::RTreeObject::envelope(&bounds(a as usize));
+            tree.locate_in_envelope_intersecting(&envelope)
+                .filter(|b| b.data != a)
+                .filter(|b| !distant_only || !shares_vertex(surface, a, b.data))
+                .filter(|b| triangle_pair_intersects(surface, a, b.data))
+                .map(|b| (a.min(b.data), a.max(b.data)))
                 .collect::<Vec<_>>()
         })
         .collect();
     pairs.sort_unstable();
+    pairs.dedup();
     pairs
 }
 
-fn envelope(g: &GeomWithData<Rectangle<[f64; 3]>, u32>) -> AABB<[f64; 3]> {
-    rstar::RTreeObject::envelope(g.geom())
+fn shares_vertex(surface: &Surface, a: u32, b: u32) -> bool {
+    let tb = surface.triangles[b as usize];
+    surface.triangles[a as usize].iter().any(|v| tb.contains(v))
 }
 
 /// Whether triangles `a` and `b` of the surface intersect improperly: sharing no vertex, they
