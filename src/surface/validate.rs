@@ -13,11 +13,10 @@ use std::fmt;
 use std::time::Instant;
 
 use rayon::prelude::*;
-use rstar::primitives::{GeomWithData, Rectangle};
-use rstar::RTree;
 
 use super::topology::{FanScratch, Topology};
 use super::Surface;
+use crate::geometry::grid::overlapping_pairs;
 use crate::geometry::intersect::{folds_over_shared_edge, meet_beyond_shared_vertex, triangles_intersect};
 use crate::geometry::predicates::{orient2d, orient3d, Sign};
 use crate::geometry::{Aabb, DVec3};
@@ -483,7 +482,7 @@ fn duplicate_triangles(triangles: &[[u32; 3]]) -> Vec<(u32, u32)> {
     pairs
 }
 
-/// All intersecting pairs (a < b): an R-tree of the triangles' boxes proposes the pairs whose
+/// All intersecting pairs (a < b): a grid of the triangles' boxes proposes the pairs whose
 /// boxes touch, the exact tests decide (see [`triangle_pair_intersects`]).
 pub fn intersecting_pairs(surface: &Surface) -> Vec<(u32, u32)> {
     let all: Vec<u32> = (0..surface.triangles.len() as u32).collect();
@@ -494,28 +493,19 @@ pub fn intersecting_pairs(surface: &Surface) -> Vec<(u32, u32)> {
 /// `distant_only`, pairs of triangles sharing a vertex are not tested (a caller that knows its
 /// neighbouring triangles are consistent saves most of the exact tests).
 pub fn intersecting_pairs_with(surface: &Surface, queries: &[u32], distant_only: bool) -> Vec<(u32, u32)> {
-    let bounds = |t: usize| {
-        let b = Aabb::from_points(&surface.triangle_points(t));
-        Rectangle::from_corners(b.min.to_array(), b.max.to_array())
-    };
-    let boxes: Vec<GeomWithData<Rectangle<[f64; 3]>, u32>> =
-        (0..surface.triangles.len()).map(|t| GeomWithData::new(bounds(t), t as u32)).collect();
-    let tree = RTree::bulk_load(boxes);
-    let mut pairs: Vec<(u32, u32)> = queries
-        .par_iter()
-        .flat_map_iter(|&a| {
-            let envelope = rstar::RTreeObject::envelope(&bounds(a as usize));
-            tree.locate_in_envelope_intersecting(&envelope)
-                .filter(|b| b.data != a)
-                .filter(|b| !distant_only || !shares_vertex(surface, a, b.data))
-                .filter(|b| triangle_pair_intersects(surface, a, b.data))
-                .map(|b| (a.min(b.data), a.max(b.data)))
-                .collect::<Vec<_>>()
-        })
+    let boxes: Vec<Aabb> = (0..surface.triangles.len())
+        .into_par_iter()
+        .map(|t| Aabb::from_points(&surface.triangle_points(t)))
         .collect();
-    pairs.sort_unstable();
-    pairs.dedup();
-    pairs
+    let mut is_query = vec![false; boxes.len()];
+    for &q in queries {
+        is_query[q as usize] = true;
+    }
+    overlapping_pairs(&boxes, &is_query)
+        .into_par_iter()
+        .filter(|&(a, b)| !distant_only || !shares_vertex(surface, a, b))
+        .filter(|&(a, b)| triangle_pair_intersects(surface, a, b))
+        .collect()
 }
 
 fn shares_vertex(surface: &Surface, a: u32, b: u32) -> bool {
