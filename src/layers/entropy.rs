@@ -15,6 +15,11 @@ use glam::DVec3;
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
 
+/// Two columns meet when their proposed top edge keeps less than this fraction of its bottom
+/// edge: merging them then moves neither far (merging columns still apart twists the lateral
+/// faces of the cells around them).
+pub const MEETING_RATIO: f64 = 0.25;
+
 /// Two scales closer than this ratio are the same kind of column.
 const SAME_SCALE: f64 = 1.01;
 
@@ -85,6 +90,7 @@ fn collapse_most_shrunk_edge(
         .map(|i| (n[i], n[(i + 1) % n.len()]))
         .filter(|&(a, b)| moving_roots(plan, a, b) && plan.merges.can_collapse(front, a, b))
         .map(|(a, b)| (edge_ratio(plan, columns, points, a, b), a, b))
+        .filter(|&(ratio, _, _)| ratio < MEETING_RATIO)
         .min_by(|x, y| x.0.total_cmp(&y.0))?;
     collapse(plan, columns, a, b);
     Some(plan.merges.root(a))
