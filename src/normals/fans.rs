@@ -119,7 +119,7 @@ pub fn wall_normals(
     }
     let fan_edges: Vec<u32> = (0..topology.edge_count() as u32).filter(|&e| is_fan_edge(e)).collect();
     let segments = fan_segments(topology, &fan_edges, &fan_ends, &out.columns, fan_angle);
-    let fans = fan_columns(topology, &fan_edges, &segments, &fan_ends, &mut out);
+    let fans = fan_columns(surface, topology, &fan_edges, &segments, &fan_ends, &mut out);
     strips(surface, topology, &fan_edges, &segments, &fans, &mut out);
     corner_patches(surface, topology, &fan_edges, &fan_ends, &fans, fan_angle, &mut out);
     out.stats.columns = out.columns.len();
@@ -258,6 +258,7 @@ struct FanColumns {
 }
 
 fn fan_columns(
+    surface: &Surface,
     topology: &Topology,
     fan_edges: &[u32],
     segments: &[u32],
@@ -288,13 +289,89 @@ fn fan_columns(
                         _ => None,
                     }
                 });
-            at[i][side] = match shared {
-                Some(cols) => cols,
-                None => interpolated_fan(v, a, b, m, out),
+            let other = (ends.len() == 2).then(|| ends.iter().find(|x| x.0 != e).copied()).flatten();
+            at[i][side] = match (shared, other) {
+                (Some(cols), _) => cols,
+                (None, Some(other)) if a != b => {
+                    ridge_vertex_fan(surface, topology, v, (e, other), (a, b), m, out)
+                }
+                (None, _) => interpolated_fan(v, a, b, m, out),
             };
         }
     }
     FanColumns { at }
+}
+
+/// The normals of the triangles on the t1 and t2 sides of edge `e`, and its unit direction
+/// leaving vertex `v`.
+fn edge_sides(surface: &Surface, topology: &Topology, e: u32, v: u32) -> (DVec3, DVec3, DVec3) {
+    let [p, q] = topology.edges[e as usize];
+    let t1 = topology.triangle_using(e, p, q);
+    let t2 = topology.other_triangle(e, t1);
+    let w = if p == v { q } else { p };
+    let dir = (surface.points[w as usize] - surface.points[v as usize]).normalize_or_zero();
+    (surface.triangle_normal(t1 as usize), surface.triangle_normal(t2 as usize), dir)
+}
+
+/// Columns across fan edge `e` at a vertex whose other fan edge is `other` (an entry of the
+/// vertex's fan ends): each column ends where the offset cylinders around the two edges meet,
+/// so the front stays at the layer distance from both. On a straight ridge that is the plain
+/// fan; where the ridge turns (at a saddle, where a concave bisector meets the fan) the columns
+/// lengthen and lean, as the exact offset does.
+fn ridge_vertex_fan(
+    surface: &Surface,
+    topology: &Topology,
+    v: u32,
+    (e, other): (u32, (u32, u32, u32)),
+    (a, b): (u32, u32),
+    m: usize,
+    out: &mut WallNormals,
+) -> Vec<u32> {
+    let (p1, q1, d1) = edge_sides(surface, topology, e, v);
+    let (p2, q2, d2) = edge_sides(surface, topology, other.0, v);
+    // The other edge's fan runs from its t1 side; it turns the same way as ours if that side is
+    // the same sector as ours.
+    let same_way = other.1 == a;
+    let mut cols = vec![a];
+    for j in 1..m {
+        let t = j as f64 / m as f64;
+        let u1 = slerp(p1, q1, t);
+        let u2 = if same_way { slerp(p2, q2, t) } else { slerp(q2, p2, t) };
+        let (direction, scale) = match cylinders_meet(u1, d1, u2, d2) {
+            Some(x) if x.length() <= MAX_RIDGE_FAN_SCALE => (x.normalize(), x.length()),
+            _ => (slerp(out.columns[a as usize].direction, out.columns[b as usize].direction, t), 1.0),
+        };
+        cols.push(out.columns.len() as u32);
+        out.columns.push(ColumnSeed { vertex: v, direction, scale });
+        out.stats.fan_columns += 1;
+    }
+    cols.push(b);
+    cols
+}
+
+/// Where a ridge turns by less than this angle (radians) its fans stay plain.
+const RIDGE_TURN: f64 = std::f64::consts::FRAC_PI_6;
+
+/// Longest ridge-vertex fan column, in layer distances (beyond it the two edges are nearly
+/// parallel and the plain fan is used).
+const MAX_RIDGE_FAN_SCALE: f64 = 3.0;
+
+/// The point at unit distance from both edge lines through the origin (directions `d1`, `d2`),
+/// reached along the fan directions `u1` and `u2` (each perpendicular to its edge): the
+/// least-squares meeting point of `u1 + alpha d1` and `u2 + beta d2`. `None` for parallel edges.
+fn cylinders_meet(u1: DVec3, d1: DVec3, u2: DVec3, d2: DVec3) -> Option<DVec3> {
+    let c = d1.dot(d2);
+    let det = 1.0 - c * c;
+    // Edges continuing each other (a ridge turning by less than RIDGE_TURN) keep the plain fan.
+    if c < -RIDGE_TURN.cos() || det < 1e-9 {
+        return None;
+    }
+    let r = u2 - u1;
+    // Normal equations of min |alpha d1 - beta d2 - r|^2.
+    let (r1, r2) = (d1.dot(r), -d2.dot(r));
+    let alpha = (r1 + c * r2) / det;
+    let beta = (c * r1 + r2) / det;
+    Some(0.5 * ((u1 + alpha * d1) + (u2 + beta * d2)))
 }
 
 /// Columns from `a` (index 0) to `b` (index m) at vertex v, new ones in between.
@@ -514,5 +591,25 @@ mod closed_front_tests {
                 .collect();
             assert!(bad.is_empty(), "{name}: {} unmatched front edges: {}", bad.len(), show.join("; "));
         }
+    }
+}
+
+#[cfg(test)]
+mod ridge_fan_tests {
+    use super::*;
+
+    #[test]
+    fn saddle_fan_columns_meet_both_cylinders() {
+        // L-block saddle: edges along +z (faces +x, -y) and +x (faces +z, -y).
+        for phi in [0.0f64, 0.3, 0.8, 1.2, std::f64::consts::FRAC_PI_2] {
+            let (c, s) = (phi.cos(), phi.sin());
+            let x =
+                cylinders_meet(DVec3::new(c, -s, 0.0), DVec3::Z, DVec3::new(0.0, -s, c), DVec3::X).unwrap();
+            assert!((x - DVec3::new(c, -s, c)).length() < 1e-12, "{phi}: {x}");
+            // At unit distance from both edge lines.
+            assert!(((x - x.dot(DVec3::Z) * DVec3::Z).length() - 1.0).abs() < 1e-12);
+            assert!(((x - x.dot(DVec3::X) * DVec3::X).length() - 1.0).abs() < 1e-12);
+        }
+        assert!(cylinders_meet(DVec3::Y, DVec3::X, DVec3::Y, -DVec3::X).is_none(), "a straight ridge");
     }
 }
