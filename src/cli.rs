@@ -60,7 +60,7 @@ enum Command {
 struct MeshArgs {
     /// Input surface (.stl, .obj, .off, .msh, .mesh, .meshb, .tri, .uh3d).
     input: PathBuf,
-    /// Output mesh; the format follows the extension (.msh, .vtu).
+    /// Output mesh; the format follows the extension (.msh, .vtu, .su2, .mesh, .meshb).
     #[arg(short, long)]
     output: PathBuf,
     /// TOML configuration file (flags override it).
@@ -165,7 +165,7 @@ fn check(path: &Path, json: bool) -> Result<ExitCode> {
 
 fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
     let format = MeshFormat::from_path(&args.output, args.ascii).with_context(|| {
-        format!("{}: unknown output format (expected .msh or .vtu)", args.output.display())
+        format!("{}: unknown output format (expected {})", args.output.display(), io::MESH_EXTENSIONS)
     })?;
     let config = mesh_config(args)?;
     let surface = io::read_surface(&args.input)?;
