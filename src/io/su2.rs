@@ -16,14 +16,12 @@ const VTK_QUAD: u8 = 9;
 /// Write `mesh` as an SU2 mesh.
 pub fn write(w: &mut dyn Write, mesh: &VolumeMesh) -> io::Result<()> {
     writeln!(w, "% SU2 mesh written by blmesh\n%\nNDIME= 3\nNELEM= {}", mesh.cell_count())?;
-    let mut index = 0u64;
-    for (kind, nodes) in mesh.cells() {
+    for (index, (kind, nodes)) in mesh.cells().enumerate() {
         write!(w, "{}", kind.vtk_type())?;
         for &local in kind.vtk_permutation() {
             write!(w, " {}", nodes[local])?;
         }
         writeln!(w, " {index}")?;
-        index += 1;
     }
     writeln!(w, "NPOIN= {}", mesh.points.len())?;
     for (i, p) in mesh.points.iter().enumerate() {
