@@ -1,4 +1,4 @@
-//! The `blmesh` command line: `info`, `check` and `mesh`.
+//! The `blmesh` command line: `info`, `check`, `mesh` and `yplus`.
 //!
 //! Errors are printed as one message naming the problem and exit with a non-zero code; outputs
 //! are written atomically, so a failed run leaves no partial file.
@@ -15,6 +15,7 @@ use crate::pipeline::{self, MeshOptions};
 use crate::progress::Progress;
 use crate::quality;
 use crate::surface::info::{SurfaceInfo, ValidationSummary};
+use crate::yplus::FlowConditions;
 
 /// Exit code for invalid input or a failed run (clap itself uses 2 for bad usage).
 const EXIT_FAILURE: u8 = 1;
@@ -54,13 +55,37 @@ enum Command {
     },
     /// Build the boundary-layer mesh of a surface.
     Mesh(MeshArgs),
+    /// First-layer height for a target y+ (Schlichting flat-plate skin friction, Re < 1e9).
+    Yplus(YplusArgs),
+}
+
+#[derive(Args, Debug)]
+struct YplusArgs {
+    /// Reynolds number on the reference length.
+    #[arg(long, allow_negative_numbers = true)]
+    re: f64,
+    /// Reference length (the height comes out in its units).
+    #[arg(long, allow_negative_numbers = true)]
+    length: f64,
+    /// Target y+ of the first layer.
+    #[arg(long, allow_negative_numbers = true)]
+    yplus: f64,
+    /// Free-stream velocity (with --density and --viscosity; SI units, --length in m).
+    #[arg(long, allow_negative_numbers = true, requires_all = ["density", "viscosity"])]
+    velocity: Option<f64>,
+    /// Density.
+    #[arg(long, allow_negative_numbers = true, requires_all = ["velocity", "viscosity"])]
+    density: Option<f64>,
+    /// Dynamic viscosity.
+    #[arg(long, allow_negative_numbers = true, requires_all = ["velocity", "density"])]
+    viscosity: Option<f64>,
 }
 
 #[derive(Args, Debug)]
 struct MeshArgs {
     /// Input surface (.stl, .obj, .off, .msh, .mesh, .meshb, .tri, .uh3d).
     input: PathBuf,
-    /// Output mesh; the format follows the extension (.msh, .vtu).
+    /// Output mesh; the format follows the extension (.msh, .vtu, .su2, .mesh, .meshb).
     #[arg(short, long)]
     output: PathBuf,
     /// TOML configuration file (flags override it).
@@ -113,6 +138,7 @@ pub fn main() -> ExitCode {
         Command::Info { surface, json, feature_angle } => info(&surface, json, feature_angle),
         Command::Check { mesh, json } => check(&mesh, json),
         Command::Mesh(args) => mesh(&args, cli.quiet, progress),
+        Command::Yplus(args) => yplus(&args),
     };
     match result {
         Ok(code) => code,
@@ -165,7 +191,7 @@ fn check(path: &Path, json: bool) -> Result<ExitCode> {
 
 fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
     let format = MeshFormat::from_path(&args.output, args.ascii).with_context(|| {
-        format!("{}: unknown output format (expected .msh or .vtu)", args.output.display())
+        format!("{}: unknown output format (expected {})", args.output.display(), io::MESH_EXTENSIONS)
     })?;
     let config = mesh_config(args)?;
     let surface = io::read_surface(&args.input)?;
@@ -185,6 +211,40 @@ fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
     if !quiet {
         print_out(&out.report.to_string());
     }
+    Ok(ExitCode::SUCCESS)
+}
+
+fn yplus(args: &YplusArgs) -> Result<ExitCode> {
+    let flow = FlowConditions {
+        reynolds: args.re,
+        length: args.length,
+        velocity: args.velocity,
+        density: args.density,
+        viscosity: args.viscosity,
+    };
+    let h = flow.first_height(args.yplus)?;
+    let dimensional = flow.velocity.is_some();
+    // Dimensional inputs are one unit system: SI units are shown.
+    let length_unit = if dimensional { "m" } else { "(any length unit)" };
+    let mut lines = vec![
+        "flat-plate skin friction (Schlichting): Cf = (2 log10(Re) - 0.65)^-2.3, valid for Re < 1e9".into(),
+        format!("Reynolds number    Re    = {:.6e}", flow.reynolds),
+        format!("reference length   L     = {:.6e} {length_unit}", flow.length),
+        format!("target y+                = {}", args.yplus),
+    ];
+    if let (Some(u), Some(rho), Some(mu)) = (flow.velocity, flow.density, flow.viscosity) {
+        lines.push(format!("velocity           U     = {u:.6e} m/s"));
+        lines.push(format!("density            rho   = {rho:.6e} kg/m^3"));
+        lines.push(format!("dynamic viscosity  mu    = {mu:.6e} Pa s"));
+    }
+    lines.push(format!("skin friction      Cf    = {:.6e}", h.cf));
+    if let (Some(tau), Some(u_tau)) = (h.wall_shear_stress, h.friction_velocity) {
+        lines.push(format!("wall shear stress  tau_w = {tau:.6e} Pa"));
+        lines.push(format!("friction velocity  u_tau = {u_tau:.6e} m/s"));
+    }
+    let unit = if dimensional { "m" } else { "(units of L)" };
+    lines.push(format!("first layer height y     = {:.6e} {unit}", h.height));
+    print_out(&lines.join("\n"));
     Ok(ExitCode::SUCCESS)
 }
 

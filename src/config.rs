@@ -10,18 +10,24 @@
 //! feature_angle = 30.0         # degrees: edges turning more are ridges
 //! fan_angle = 20.0             # degrees: largest angle between neighbouring fan normals
 //! [layers]
-//! first_height = 1.0e-5        # h0
+//! first_height = 1.0e-5        # h0, or: yplus = 1.0 with [flow_conditions] (see `crate::yplus`)
 //! growth = 1.2                 # r: layer k is h0 r^k high
 //! count = 25                   # or: thickness = 0.05, or: count = "auto" (stop at isotropy)
 //! [[patch]]
 //! match = "face9"              # patch name or regex (whole name)
 //! role = "symmetry"            # wall | symmetry | farfield | inlet | outlet | none
-//! first_height = 2.0e-5        # per-patch layer overrides (wall patches)
+//! first_height = 2.0e-5        # per-patch layer overrides (wall patches), or yplus = ...
+//! [flow_conditions]            # for yplus: Re on a reference length (heights in its units)
+//! reynolds = 14.6e6
+//! length = 646.07
+//! # velocity, density, viscosity: all three or none, same unit system as length
 //! ```
 
 use std::path::Path;
 
 use serde::{Deserialize, Serialize};
+
+use crate::yplus::FlowConditions;
 
 /// Default first-layer height, as a fraction of the bounding-box diagonal.
 pub const DEFAULT_FIRST_HEIGHT_REL: f64 = 1e-3;
@@ -183,8 +189,14 @@ impl Config {
         Self::from_toml_str(&text).map_err(|message| ConfigError::Syntax { path: path.to_owned(), message })
     }
 
+    /// Parse a config; `yplus` keys are resolved into `first_height` with `[flow_conditions]`.
     pub fn from_toml_str(text: &str) -> Result<Config, String> {
-        toml::from_str(text).map_err(|e| e.to_string())
+        let mut table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+        if !resolve_yplus(&mut table).map_err(|e| e.to_string())? {
+            // Deserializing the text itself keeps line numbers in the errors.
+            return toml::from_str(text).map_err(|e| e.to_string());
+        }
+        table.try_into().map_err(|e: toml::de::Error| e.to_string())
     }
 
     pub fn feature_angle(&self) -> f64 {
@@ -227,6 +239,49 @@ impl Config {
         }
         (role, layers)
     }
+}
+
+/// Replace every `yplus` (in `[layers]` and `[[patch]]`) by the `first_height` it gives at the
+/// `[flow_conditions]`, and remove that table; false when the config has neither.
+fn resolve_yplus(table: &mut toml::Table) -> Result<bool, ConfigError> {
+    let flow = match table.remove("flow_conditions") {
+        Some(value) => Some(
+            FlowConditions::deserialize(value)
+                .map_err(|e| bad("flow_conditions", "(table)", &e.to_string()))?,
+        ),
+        None => None,
+    };
+    let mut found = flow.is_some();
+    if let Some(toml::Value::Table(layers)) = table.get_mut("layers") {
+        found |= resolve_yplus_in("layers", layers, flow.as_ref())?;
+    }
+    if let Some(toml::Value::Array(patches)) = table.get_mut("patch") {
+        for (i, patch) in patches.iter_mut().enumerate() {
+            if let toml::Value::Table(patch) = patch {
+                found |= resolve_yplus_in(&format!("patch[{i}]"), patch, flow.as_ref())?;
+            }
+        }
+    }
+    Ok(found)
+}
+
+/// Replace `yplus` in one layer-settings table (`what` names it in errors); false when absent.
+fn resolve_yplus_in(
+    what: &str,
+    layers: &mut toml::Table,
+    flow: Option<&FlowConditions>,
+) -> Result<bool, ConfigError> {
+    let Some(yplus) = layers.remove("yplus") else { return Ok(false) };
+    let name = format!("{what}.yplus");
+    let yplus = yplus.as_float().or(yplus.as_integer().map(|i| i as f64));
+    let yplus = yplus.ok_or_else(|| bad(&name, "(not a number)", "must be a number"))?;
+    if layers.contains_key("first_height") {
+        return Err(bad(&name, yplus, "give either first_height or yplus, not both"));
+    }
+    let flow = flow.ok_or_else(|| bad(&name, yplus, "needs a [flow_conditions] table"))?;
+    let height = flow.first_height(yplus)?.height;
+    layers.insert("first_height".into(), toml::Value::Float(height));
+    Ok(true)
 }
 
 fn validate_layer_settings(what: &str, s: &LayerSettings) -> Result<(), ConfigError> {
@@ -366,6 +421,34 @@ mod tests {
         assert!(Config::from_toml_str("[layers]\ncount = 0").is_err());
         assert!(Config::from_toml_str("[layers]\ncount = \"many\"").is_err());
         assert!(Config::from_toml_str("unknown_key = 1").is_err());
+    }
+
+    #[test]
+    fn yplus_resolves_the_first_height_from_the_flow_conditions() {
+        let c = Config::from_toml_str(
+            "[layers]\nyplus = 1.0\ncount = 25\n[flow_conditions]\nreynolds = 14.6e6\nlength = 646.07\n\
+             [[patch]]\nmatch = \"fin\"\nyplus = 2\n",
+        )
+        .unwrap();
+        c.validate().unwrap();
+        let h = c.layers.first_height.unwrap();
+        assert!((h - 1.26734e-3).abs() < 1e-8, "{h}"); // mm, see crate::yplus
+        let fin = c.patch_settings("fin").1.first_height.unwrap();
+        assert!((fin - 2.0 * h).abs() < 1e-15);
+        let errors = [
+            ("[layers]\nyplus = 1.0", "needs a [flow_conditions]"),
+            (
+                "[layers]\nyplus = 1.0\nfirst_height = 1e-3\n[flow_conditions]\nreynolds = 1e6\nlength = 1.0",
+                "not both",
+            ),
+            ("[layers]\nyplus = -1.0\n[flow_conditions]\nreynolds = 1e6\nlength = 1.0", "yplus"),
+            ("[layers]\nyplus = 1.0\n[flow_conditions]\nreynolds = 1e6", "length"),
+            ("[flow_conditions]\nreynolds = 1e6\nlength = 1.0\nspeed = 3.0", "unknown field"),
+        ];
+        for (text, expected) in errors {
+            let e = Config::from_toml_str(text).unwrap_err();
+            assert!(e.contains(expected), "{text}: {e}");
+        }
     }
 
     #[test]

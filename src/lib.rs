@@ -23,3 +23,4 @@ pub mod pipeline;
 pub mod progress;
 pub mod quality;
 pub mod surface;
+pub mod yplus;

@@ -259,3 +259,21 @@ fn mesh_runs_end_to_end_on_every_shared_surface() {
     }
     eprintln!("{}", rows.join("\n"));
 }
+
+#[test]
+fn yplus_prints_the_first_height_and_refuses_bad_inputs() {
+    let o = blmesh(&["yplus", "--re", "14.6e6", "--length", "0.64607", "--yplus", "1"]);
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(o.status.success(), "{}", stderr(&o));
+    assert!(out.contains("Schlichting") && out.contains("Cf    = 2.438352e-3"), "{out}");
+    assert!(out.contains("first layer height y     = 1.267341e-6 (units of L)"), "{out}");
+    let air = ["--velocity", "330.0993", "--density", "1.225", "--viscosity", "1.7894e-5"];
+    let o = blmesh(&[&["yplus", "--re", "14.6e6", "--length", "0.64607", "--yplus", "1"][..], &air].concat());
+    let out = String::from_utf8_lossy(&o.stdout);
+    assert!(out.contains("u_tau = 1.152598e1 m/s") && out.contains("= 1.267341e-6 m"), "{out}");
+    assert_fails_with(&blmesh(&["yplus", "--re", "-1", "--length", "1", "--yplus", "1"]), &["reynolds"]);
+    assert_fails_with(&blmesh(&["yplus", "--re", "1e6", "--length", "inf", "--yplus", "1"]), &["length"]);
+    assert_fails_with(&blmesh(&["yplus", "--re", "1e6", "--length", "1", "--yplus", "0"]), &["yplus"]);
+    let o = blmesh(&[&["yplus", "--re", "1e6", "--length", "1", "--yplus", "1"][..], &air].concat());
+    assert_fails_with(&o, &["inconsistent units"]);
+}

@@ -1,11 +1,12 @@
 //! Our MSH (ASCII, binary) and VTU files: read back by our readers, by meshio and by Gmsh
 //! (`tests/python/interop.py`, run with the interpreter named by `BLMESH_PYTHON`), and the files
-//! meshio and Gmsh write from them read back by our readers.
+//! meshio and Gmsh write from them read back by our readers. Our SU2 and Medit files (no volume
+//! reader of ours) are read by meshio; the Medit boundary also by our surface reader.
 
 use std::path::{Path, PathBuf};
 use std::process::Command;
 
-use blmesh::io::{read_volume_mesh, write_volume_mesh, MeshFormat};
+use blmesh::io::{read_surface, read_volume_mesh, write_volume_mesh, MeshFormat};
 use blmesh::mesh::{CellKind, VolumeMesh};
 use blmesh::quality::{check, samples::hybrid_column, CheckReport};
 
@@ -114,9 +115,20 @@ fn assert_interoperates(mesh: &VolumeMesh) {
             assert_eq!(back.zone_names, mesh.zone_names);
         }
     }
+    let solver_files: Vec<(PathBuf, MeshFormat)> = vec![
+        (dir.path().join("mesh.su2"), MeshFormat::Su2),
+        (dir.path().join("ascii.mesh"), MeshFormat::Medit { binary: false }),
+        (dir.path().join("binary.meshb"), MeshFormat::Medit { binary: true }),
+    ];
+    for (path, format) in &solver_files {
+        write_volume_mesh(path, mesh, *format).unwrap();
+    }
+    for (path, _) in &solver_files[1..] {
+        assert_medit_boundary(path, mesh, original.volume.cells);
+    }
     let Some(python) = python() else { return };
     let groups: Vec<&str> = mesh.patch_names.iter().chain(&mesh.zone_names).map(String::as_str).collect();
-    for (path, _) in &files {
+    for (path, _) in files.iter().chain(&solver_files) {
         let mut args = vec!["check".to_string(), path.display().to_string()];
         args.extend(expectations(mesh, original.volume.cells));
         if path.extension().is_some_and(|e| e == "msh") {
@@ -125,6 +137,16 @@ fn assert_interoperates(mesh: &VolumeMesh) {
         run(&python, &args.iter().map(String::as_str).collect::<Vec<_>>());
     }
     read_other_tools_files(&python, &files[1].0, &files[2].0, dir.path(), &original);
+}
+
+/// The boundary of a Medit volume file, read by our surface reader: every face (quadrilaterals
+/// split in two), enclosing the mesh's volume.
+fn assert_medit_boundary(path: &Path, mesh: &VolumeMesh, volume: f64) {
+    let surface = read_surface(path).unwrap_or_else(|e| panic!("{e}"));
+    let b = &mesh.boundary;
+    assert_eq!(surface.triangles.len(), b.triangles.len() + 2 * b.quads.len(), "{}", path.display());
+    let difference = (surface.enclosed_volume() - volume).abs() / volume;
+    assert!(difference < 1e-12, "{}: enclosed volume differs by {difference:e}", path.display());
 }
 
 /// Files written by meshio and Gmsh from ours, read back by our readers.

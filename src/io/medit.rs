@@ -1,4 +1,5 @@
-//! Medit / libMeshb surfaces: `.mesh` (ASCII) and `.meshb` (binary), read and written.
+//! Medit / libMeshb: `.mesh` (ASCII) and `.meshb` (binary) surfaces read and written, volume
+//! meshes written.
 //!
 //! Only `Dimension` (3, assumed when absent), `Vertices`, `Triangles` and `Quadrilaterals`
 //! (split in two triangles) are read; every other section is skipped. Each element reference
@@ -13,6 +14,7 @@ use std::io::Write;
 use super::scan::{self, ByteReader, Tokens};
 use super::ParseError;
 use crate::geometry::DVec3;
+use crate::mesh::{CellKind, VolumeMesh};
 use crate::surface::Surface;
 
 /// libMeshb keyword codes.
@@ -20,6 +22,10 @@ const DIMENSION: i32 = 3;
 const VERTICES: i32 = 4;
 const TRIANGLES: i32 = 6;
 const QUADRILATERALS: i32 = 7;
+const TETRAHEDRA: i32 = 8;
+const PRISMS: i32 = 9;
+const HEXAHEDRA: i32 = 10;
+const PYRAMIDS: i32 = 49;
 const END: i32 = 54;
 
 /// The sections read, by code and (case-insensitive) ASCII name.
@@ -273,76 +279,147 @@ fn read_elements<const N: usize>(
 /// Write `s` as Medit ASCII (`.mesh`) or binary (`.meshb`); references are patch index + 1.
 /// Binary files are version 2 (8-byte reals) when they can be, else 3 or 4 for large meshes.
 pub fn write_surface(w: &mut dyn Write, s: &Surface, binary: bool) -> std::io::Result<()> {
-    if binary {
-        write_binary(w, s)
-    } else {
-        write_ascii(w, s)
+    let sections = [Section::triangles(&s.triangles, &s.triangle_patch)];
+    write_sections(w, &s.points, &sections, binary)
+}
+
+/// Write `mesh` as a Medit volume mesh: boundary triangles and quadrilaterals with the patch
+/// index + 1 as reference, cells with the zone index + 1. Node orders are the crate's (Gmsh)
+/// ones, which are also meshio's reading of Medit files (see [`crate::mesh`]).
+pub fn write_volume(w: &mut dyn Write, mesh: &VolumeMesh, binary: bool) -> std::io::Result<()> {
+    let b = &mesh.boundary;
+    let mut sections = vec![
+        Section::triangles(&b.triangles, &b.triangle_patch),
+        Section {
+            code: QUADRILATERALS,
+            name: "Quadrilaterals",
+            nodes_per: 4,
+            nodes: b.quads.as_flattened(),
+            ids: &b.quad_patch,
+        },
+    ];
+    for block in &mesh.blocks {
+        let (code, name) = cell_section(block.kind);
+        let nodes_per = block.kind.node_count();
+        sections.push(Section { code, name, nodes_per, nodes: &block.nodes, ids: &block.zone });
+    }
+    sections.retain(|s| !s.ids.is_empty());
+    write_sections(w, &mesh.points, &sections, binary)
+}
+
+/// libMeshb code and ASCII keyword of a cell kind.
+fn cell_section(kind: CellKind) -> (i32, &'static str) {
+    match kind {
+        CellKind::Tetrahedron => (TETRAHEDRA, "Tetrahedra"),
+        CellKind::Pyramid => (PYRAMIDS, "Pyramids"),
+        CellKind::Prism => (PRISMS, "Prisms"),
+        CellKind::Hexahedron => (HEXAHEDRA, "Hexahedra"),
     }
 }
 
-fn write_ascii(w: &mut dyn Write, s: &Surface) -> std::io::Result<()> {
-    writeln!(w, "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n{}", s.points.len())?;
-    for p in &s.points {
+/// One element section to write: `nodes_per` 0-based nodes and one id per element; the
+/// reference written is id + 1 (Medit reserves 0 for "no reference").
+struct Section<'a> {
+    code: i32,
+    name: &'static str,
+    nodes_per: usize,
+    nodes: &'a [u32],
+    ids: &'a [u32],
+}
+
+impl<'a> Section<'a> {
+    fn triangles(triangles: &'a [[u32; 3]], ids: &'a [u32]) -> Self {
+        Section { code: TRIANGLES, name: "Triangles", nodes_per: 3, nodes: triangles.as_flattened(), ids }
+    }
+
+    fn elements(&self) -> impl Iterator<Item = (&'a [u32], u32)> {
+        self.nodes.chunks_exact(self.nodes_per).zip(self.ids.iter().copied())
+    }
+}
+
+fn write_sections(
+    w: &mut dyn Write,
+    points: &[DVec3],
+    sections: &[Section],
+    binary: bool,
+) -> std::io::Result<()> {
+    if binary {
+        write_binary_version(w, points, sections, binary_version(points, sections), false)
+    } else {
+        write_ascii(w, points, sections)
+    }
+}
+
+fn write_ascii(w: &mut dyn Write, points: &[DVec3], sections: &[Section]) -> std::io::Result<()> {
+    writeln!(w, "MeshVersionFormatted 2\n\nDimension 3\n\nVertices\n{}", points.len())?;
+    for p in points {
         // `{:e}` prints the shortest digits that read back to the same f64.
         writeln!(w, "{:e} {:e} {:e} 0", p.x, p.y, p.z)?;
     }
-    writeln!(w, "\nTriangles\n{}", s.triangles.len())?;
-    for (t, patch) in s.triangles.iter().zip(&s.triangle_patch) {
-        writeln!(w, "{} {} {} {}", t[0] + 1, t[1] + 1, t[2] + 1, u64::from(*patch) + 1)?;
+    for section in sections {
+        writeln!(w, "\n{}\n{}", section.name, section.ids.len())?;
+        for (nodes, id) in section.elements() {
+            for n in nodes {
+                write!(w, "{} ", u64::from(*n) + 1)?;
+            }
+            writeln!(w, "{}", u64::from(id) + 1)?;
+        }
     }
     writeln!(w, "\nEnd")
 }
 
-fn write_binary(w: &mut dyn Write, s: &Surface) -> std::io::Result<()> {
-    write_binary_version(w, s, binary_version(s), false)
-}
-
-/// Write `s` in binary libMeshb `version`, in either byte order (readers must take both).
+/// Write the sections in binary libMeshb `version`, in either byte order (readers must take both).
 fn write_binary_version(
     w: &mut dyn Write,
-    s: &Surface,
+    points: &[DVec3],
+    sections: &[Section],
     version: i32,
     big_endian: bool,
 ) -> std::io::Result<()> {
     let layout = Layout::of_version(version);
     let int = if layout.int8 { 8 } else { 4 };
     let real = if layout.real8 { 8 } else { 4 };
-    let position = if layout.position8 { 8 } else { 4 };
-    let vertices_at = 8 + 4 + position + 4;
-    let triangles_at = vertices_at + 4 + position + int + s.points.len() as u64 * (3 * real + int);
-    let end_at = triangles_at + 4 + position + int + s.triangles.len() as u64 * 4 * int;
+    let keyword = 4 + if layout.position8 { 8 } else { 4 };
+    let vertices_at = 8 + keyword + 4;
+    let mut next = vertices_at + keyword + int + points.len() as u64 * (3 * real + int);
     let mut out = BinaryWriter { w, layout, big_endian };
     out.number(1, 4)?;
     out.number(version as u64, 4)?;
     out.keyword(DIMENSION, vertices_at)?;
     out.number(3, 4)?;
-    out.keyword(VERTICES, triangles_at)?;
-    out.int(s.points.len() as u64)?;
-    for p in &s.points {
+    out.keyword(VERTICES, next)?;
+    out.int(points.len() as u64)?;
+    for p in points {
         for c in p.to_array() {
             out.real(c)?;
         }
         out.int(0)?;
     }
-    out.keyword(TRIANGLES, end_at)?;
-    out.int(s.triangles.len() as u64)?;
-    for (t, &patch) in s.triangles.iter().zip(&s.triangle_patch) {
-        for v in t {
-            out.int(u64::from(*v) + 1)?;
+    for section in sections {
+        next += keyword + int + section.ids.len() as u64 * (section.nodes_per as u64 + 1) * int;
+        out.keyword(section.code, next)?;
+        out.int(section.ids.len() as u64)?;
+        for (nodes, id) in section.elements() {
+            for n in nodes {
+                out.int(u64::from(*n) + 1)?;
+            }
+            out.int(u64::from(id) + 1)?;
         }
-        out.int(u64::from(patch) + 1)?;
     }
     out.keyword(END, 0)
 }
 
-/// The smallest libMeshb version with 8-byte reals that holds `s`.
-fn binary_version(s: &Surface) -> i32 {
+/// The smallest libMeshb version with 8-byte reals that holds the points and sections.
+fn binary_version(points: &[DVec3], sections: &[Section]) -> i32 {
     let fits_i32 = |n: usize| n < i32::MAX as usize;
-    if !fits_i32(s.points.len()) || !fits_i32(s.triangles.len()) || !fits_i32(s.patch_names.len()) {
+    let counts_fit =
+        sections.iter().all(|s| fits_i32(s.ids.len()) && s.ids.iter().all(|&i| i < i32::MAX as u32));
+    if !fits_i32(points.len()) || !counts_fit {
         return 4;
     }
     // Upper bound of a version-2 file's size: its positions must fit in 4 bytes.
-    let size = 64 + 28 * s.points.len() as u64 + 16 * s.triangles.len() as u64;
+    let elements: u64 = sections.iter().map(|s| 4 * (s.nodes_per as u64 + 1) * s.ids.len() as u64).sum();
+    let size = 64 + 16 * sections.len() as u64 + 28 * points.len() as u64 + elements;
     if size < i32::MAX as u64 {
         2
     } else {
@@ -474,7 +551,8 @@ End
 
     fn written(s: &Surface, version: i32, big_endian: bool) -> Vec<u8> {
         let mut bytes = Vec::new();
-        write_binary_version(&mut bytes, s, version, big_endian).unwrap();
+        let sections = [Section::triangles(&s.triangles, &s.triangle_patch)];
+        write_binary_version(&mut bytes, &s.points, &sections, version, big_endian).unwrap();
         bytes
     }
 
@@ -507,6 +585,29 @@ End
         let mut binary = Vec::new();
         write_surface(&mut binary, &s, true).unwrap();
         assert_eq!(binary, written(&s, 2, false));
+    }
+
+    #[test]
+    fn volume_mesh_boundary_reads_back_and_cells_are_counted() {
+        let mesh = crate::quality::samples::hybrid_column();
+        let b = &mesh.boundary;
+        for binary in [false, true] {
+            let mut bytes = Vec::new();
+            write_volume(&mut bytes, &mesh, binary).unwrap();
+            let back = parse_surface(&bytes).unwrap();
+            assert_eq!(back.triangles.len(), b.triangles.len() + 2 * b.quads.len());
+            // The boundary faces (outward) enclose the column of four unit cubes.
+            assert!((back.enclosed_volume() - 4.0).abs() < 1e-12, "{}", back.enclosed_volume());
+            if !binary {
+                let text = String::from_utf8(bytes).unwrap();
+                for kind in CellKind::ALL {
+                    let name = cell_section(kind).1;
+                    let at = text.find(&format!("\n{name}\n")).unwrap();
+                    let count = text[at + name.len() + 2..].lines().next().unwrap();
+                    assert_eq!(count, mesh.block(kind).len().to_string(), "{name}");
+                }
+            }
+        }
     }
 
     /// A little-endian version-2 file made of `(code, payload)` keywords, positions filled in.

@@ -11,6 +11,7 @@ pub mod obj;
 pub mod off;
 mod scan;
 pub mod stl;
+pub mod su2;
 pub mod uh3d;
 pub mod vtu;
 
@@ -151,7 +152,16 @@ pub enum MeshFormat {
         ascii: bool,
     },
     Vtu,
+    /// SU2 native (ASCII), patches as markers.
+    Su2,
+    /// Medit `.meshb` (binary) or `.mesh` (ASCII), patch and zone index + 1 as references.
+    Medit {
+        binary: bool,
+    },
 }
+
+/// The volume mesh output extensions, for messages.
+pub const MESH_EXTENSIONS: &str = ".msh, .vtu, .su2, .mesh, .meshb";
 
 impl MeshFormat {
     pub fn from_path(path: &Path, ascii: bool) -> Option<Self> {
@@ -159,6 +169,9 @@ impl MeshFormat {
         match ext.as_str() {
             "msh" => Some(MeshFormat::Msh { ascii }),
             "vtu" => Some(MeshFormat::Vtu),
+            "su2" => Some(MeshFormat::Su2),
+            "mesh" => Some(MeshFormat::Medit { binary: false }),
+            "meshb" => Some(MeshFormat::Medit { binary: true }),
             _ => None,
         }
     }
@@ -169,6 +182,8 @@ pub fn write_volume_mesh(path: &Path, mesh: &VolumeMesh, format: MeshFormat) -> 
     write_atomic(path, |w| match format {
         MeshFormat::Msh { ascii } => msh::write(w, mesh, ascii),
         MeshFormat::Vtu => vtu::write(w, mesh),
+        MeshFormat::Su2 => su2::write(w, mesh),
+        MeshFormat::Medit { binary } => medit::write_volume(w, mesh, binary),
     })
 }
 

@@ -13,7 +13,12 @@
 //!              lateral edges 0-4, 1-5, 2-6, 3-7.
 //! ```
 //! VTK uses the same orders except the prism (VTK_WEDGE), whose bottom normal points away from the
-//! top: VTK wedge = Gmsh prism permuted by [`CellKind::vtk_permutation`].
+//! top: VTK wedge = Gmsh prism permuted by [`CellKind::vtk_permutation`]. SU2 files use the VTK
+//! orders (meshio's SU2 reader does not permute them back: its wedges read from `.su2` are
+//! inverted in its own convention).
+//! Medit (`.mesh`/`.meshb`) cells are written in the Gmsh orders above, unpermuted: meshio's
+//! Medit reader and writer apply no permutation to any kind, so meshio reads them as valid
+//! cells. (libMeshb's own documentation was not checked for its pyramid/prism figures.)
 //!
 //! Faces of each kind, oriented outward, are in [`CellKind::faces`].
 

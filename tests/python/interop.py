@@ -3,11 +3,12 @@
 
 usage:
   interop.py check MESH --expect TYPE=N [--expect ...] --volume V [--groups NAME,NAME,...]
-      Load MESH (.msh or .vtu) with meshio and, for .msh, with Gmsh (gmsh.open +
+      Load MESH (.msh, .vtu, .su2, .mesh, .meshb) with meshio and, for .msh, with Gmsh (gmsh.open +
       gmsh.model.mesh.getElements); compare the element counts by meshio type name (tetra,
       pyramid, wedge, hexahedron, triangle, quad) and the total cell volume (within 1e-9
       relative) with the expected values; for .msh also the physical group names. Exit 1 on
-      any mismatch.
+      any mismatch. SU2 stores prisms in VTK order and meshio's SU2 reader keeps it (meshio's
+      wedge is Gmsh's), so the wedges read from .su2 are permuted back before the volume.
   interop.py convert MSH VTU OUTDIR
       Write other tools' files for blmesh to read: meshio's default VTU (zlib), its ASCII and
       uncompressed binary VTU (from VTU), meshio's MSH 2.2 (from MSH), and Gmsh's own MSH 4.1
@@ -69,6 +70,8 @@ def check_meshio(path, expect, expected_volume, problems):
         counts[block.type] = counts.get(block.type, 0) + len(block.data)
         cells.setdefault(block.type, []).append(np.asarray(block.data, dtype=np.int64))
     cells = {t: np.vstack(c) for t, c in cells.items()}
+    if path.endswith(".su2") and "wedge" in cells:
+        cells["wedge"] = cells["wedge"][:, [0, 2, 1, 3, 5, 4]]
     vol = volume(np.asarray(m.points, dtype=float)[:, :3], cells)
     compare("meshio", counts, vol, expect, expected_volume, problems)
     print(f"meshio: {counts}, volume {vol!r}")
