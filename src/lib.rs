@@ -22,4 +22,5 @@ pub mod picture;
 pub mod pipeline;
 pub mod progress;
 pub mod quality;
+pub mod sizing;
 pub mod surface;

@@ -1,0 +1,2 @@
+pub mod metric;
+pub mod wall;
