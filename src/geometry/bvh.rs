@@ -51,6 +51,11 @@ impl TriangleBvh {
         self.corners.is_empty()
     }
 
+    /// The corner points of triangle `t`.
+    pub fn corners(&self, t: u32) -> [DVec3; 3] {
+        self.corners[t as usize]
+    }
+
     fn leaf(&self, first: usize, count: usize) -> Node {
         let bounds = Aabb::from_points(
             self.order[first..first + count].iter().flat_map(|&t| &self.corners[t as usize]),
