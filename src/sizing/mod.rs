@@ -157,8 +157,9 @@ const GAUSS: [(f64, f64); 3] = [
 impl SizingField {
     pub fn new(wall: &Surface, spec: &SizingSpec) -> Result<SizingField, SpecError> {
         spec.check()?;
+        check_wall(wall)?;
         let distance = WallDistance::new(wall);
-        let wall_size = wall::mean_edge_length_per_vertex(wall);
+        let wall_size = wall::mean_edge_length_per_vertex(&wall.points, &wall.triangles);
         let wall_size_node_min = distance.node_minimum(&wall_size);
         Ok(SizingField { spec: spec.clone(), wall: distance, wall_size, wall_size_node_min })
     }
@@ -229,6 +230,21 @@ impl SizingField {
     pub fn edge_length(&self, a: DVec3, b: DVec3) -> f64 {
         let e = b - a;
         GAUSS.iter().map(|&(t, w)| w * self.metric(a + e * t).edge_length(e)).sum()
+    }
+}
+
+/// The wall must have finite points and in-range triangle indices (a validated surface has).
+fn check_wall(wall: &Surface) -> Result<(), SpecError> {
+    if let Some(v) = wall.points.iter().position(|p| !p.is_finite()) {
+        return Err(SpecError(format!("wall point {v} is not finite: {}", wall.points[v])));
+    }
+    match wall.triangles.iter().position(|t| t.iter().any(|&v| v as usize >= wall.points.len())) {
+        Some(t) => Err(SpecError(format!(
+            "wall triangle {t} {:?} uses a vertex beyond the {} points",
+            wall.triangles[t],
+            wall.points.len()
+        ))),
+        None => Ok(()),
     }
 }
 

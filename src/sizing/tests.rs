@@ -118,6 +118,9 @@ fn bad_specs_are_named() {
     s.regions.push(Region::Box { min: DVec3::ONE, max: DVec3::ZERO, size: 0.1 });
     assert!(err(s.clone()).contains("region 0"));
     assert!(SizingField::new(&flat_wall(), &s).is_err());
+    let mut broken = flat_wall();
+    broken.triangles[0][2] = 7;
+    assert!(SizingField::new(&broken, &spec(1e-3, 1.2, 1.0)).unwrap_err().to_string().contains("triangle 0"));
 }
 
 #[test]
@@ -163,7 +166,7 @@ proptest! {
         let mut s = spec(1e-3, 1.3, 0.8);
         s.regions.push(Region::Sphere { center: DVec3::new(1.2, 0.0, 0.0), radius: 0.3, size: 0.01 });
         let field = SizingField::new(&wall, &s).unwrap();
-        let h = wall::mean_edge_length_per_vertex(&wall);
+        let h = wall::mean_edge_length_per_vertex(&wall.points, &wall.triangles);
         let spread = h.iter().cloned().fold(0.0, f64::max) - h.iter().cloned().fold(f64::INFINITY, f64::min);
         // The steepest linear interpolation on these near-equilateral triangles: < 2 spread / edge.
         let gradient = 2.0 * spread / 0.2;

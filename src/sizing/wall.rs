@@ -106,15 +106,14 @@ fn barycentric(q: DVec3, c: [DVec3; 3]) -> DVec3 {
     weights / weights.element_sum()
 }
 
-/// Mean length of the edges at every vertex of the surface (each triangle side counted from
-/// each triangle that has it).
-pub fn mean_edge_length_per_vertex(wall: &Surface) -> Vec<f64> {
-    let mut sum = vec![0.0; wall.points.len()];
-    let mut count = vec![0u32; wall.points.len()];
-    for t in &wall.triangles {
+/// Mean length of the edges at every point (each triangle side counted once per triangle
+/// using it, so both sides weigh alike); 0 for a point no triangle uses. Indices must be valid.
+pub fn mean_edge_length_per_vertex(points: &[DVec3], triangles: &[[u32; 3]]) -> Vec<f64> {
+    let (mut sum, mut count) = (vec![0.0; points.len()], vec![0u32; points.len()]);
+    for t in triangles {
         for i in 0..3 {
             let (a, b) = (t[i] as usize, t[(i + 1) % 3] as usize);
-            let length = (wall.points[a] - wall.points[b]).length();
+            let length = points[a].distance(points[b]);
             for v in [a, b] {
                 sum[v] += length;
                 count[v] += 1;
@@ -155,7 +154,7 @@ mod tests {
     fn mean_edge_lengths_of_a_unit_grid() {
         // A unit cube face split in 2x2 squares: edges 0.5 and diagonals 0.5 sqrt(2).
         let s = cuboid(DVec3::ONE, 2);
-        let h = mean_edge_length_per_vertex(&s);
+        let h = mean_edge_length_per_vertex(&s.points, &s.triangles);
         assert!(h.iter().all(|&x| (0.5..=0.5 * 2f64.sqrt()).contains(&x)), "{h:?}");
     }
 }
