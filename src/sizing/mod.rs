@@ -195,7 +195,7 @@ impl SizingField {
         let slope = self.spec.gradation - 1.0;
         let tangential = self
             .wall
-            .graded_minimum(x, &self.wall_size, &self.wall_size_node_min, slope, self.spec.max_size)
+            .graded_minimum(x, &near, &self.wall_size, &self.wall_size_node_min, slope, self.spec.max_size)
             .min(user);
         let normal_size = (self.spec.first_height + (self.spec.growth - 1.0) * near.distance).min(tangential);
         Sizes {

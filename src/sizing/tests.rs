@@ -95,8 +95,14 @@ fn the_metric_is_the_intersection_of_the_wall_and_user_metrics() {
         let near = field.wall().closest(p).unwrap();
         let n = field.wall().direction_from(&near, p);
         let (t1, t2) = n.any_orthonormal_pair();
-        let h_t =
-            field.wall.graded_minimum(p, &field.wall_size, &field.wall_size_node_min, 0.2, f64::INFINITY);
+        let h_t = field.wall.graded_minimum(
+            p,
+            &near,
+            &field.wall_size,
+            &field.wall_size_node_min,
+            0.2,
+            f64::INFINITY,
+        );
         let h_n = (1e-3 + 0.2 * near.distance).min(h_t);
         let wall = Metric::from_sizes([n, t1, t2], [h_n, h_t, h_t]);
         let expected = wall.intersect(&Metric::isotropic(field.user_size(p)));

@@ -63,8 +63,19 @@ impl WallDistance {
     /// per-vertex `values` interpolated linearly: the largest function below `v` on the wall that
     /// grows at most `slope` per unit length. Each triangle contributes its closest point and its
     /// vertices, so the result is Lipschitz (constant `slope` + the steepest `v` gradient).
-    pub fn graded_minimum(&self, p: DVec3, values: &[f64], node_min: &[f64], slope: f64, cap: f64) -> f64 {
-        let mut best = cap;
+    /// `near` is the closest wall point to `p` (its candidate seeds the search, so that it prunes
+    /// from the start).
+    pub fn graded_minimum(
+        &self,
+        p: DVec3,
+        near: &WallPoint,
+        values: &[f64],
+        node_min: &[f64],
+        slope: f64,
+        cap: f64,
+    ) -> f64 {
+        let mut best =
+            cap.min(self.interpolate(values, near.triangle, near.barycentric) + slope * near.distance);
         self.bvh.branch_and_bound_nodes(
             |bounds, node| node_min[node] + slope * box_distance_squared(p, bounds).sqrt(),
             |t, c| {
