@@ -101,21 +101,18 @@ fn rotate(a: &mut [[f64; 3]; 3], v: &mut [[f64; 3]; 3], p: usize, q: usize) {
     let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
     let c = 1.0 / (t * t + 1.0).sqrt();
     let s = t * c;
-    for k in 0..3 {
-        let (akp, akq) = (a[k][p], a[k][q]);
-        a[k][p] = c * akp - s * akq;
-        a[k][q] = s * akp + c * akq;
-    }
-    for k in 0..3 {
-        let (apk, aqk) = (a[p][k], a[q][k]);
-        a[p][k] = c * apk - s * aqk;
-        a[q][k] = s * apk + c * aqk;
-    }
-    for row in v.iter_mut() {
-        let (vp, vq) = (row[p], row[q]);
-        row[p] = c * vp - s * vq;
-        row[q] = s * vp + c * vq;
-    }
+    let turn_columns = |m: &mut [[f64; 3]; 3]| {
+        for row in m.iter_mut() {
+            let (mp, mq) = (row[p], row[q]);
+            row[p] = c * mp - s * mq;
+            row[q] = s * mp + c * mq;
+        }
+    };
+    turn_columns(a);
+    turn_columns(v);
+    let (row_p, row_q) = (a[p], a[q]);
+    a[p] = [0, 1, 2].map(|k| c * row_p[k] - s * row_q[k]);
+    a[q] = [0, 1, 2].map(|k| s * row_p[k] + c * row_q[k]);
     a[p][q] = 0.0;
     a[q][p] = 0.0;
 }

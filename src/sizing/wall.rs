@@ -108,7 +108,7 @@ fn barycentric(q: DVec3, c: [DVec3; 3]) -> DVec3 {
     let (d00, d01, d11) = (e0.dot(e0), e0.dot(e1), e1.dot(e1));
     let (d20, d21) = (eq.dot(e0), eq.dot(e1));
     let denominator = d00 * d11 - d01 * d01;
-    if !(denominator > f64::EPSILON * d00 * d11) {
+    if denominator.is_nan() || denominator <= f64::EPSILON * d00 * d11 {
         return DVec3::splat(1.0 / 3.0);
     }
     let v = (d11 * d20 - d01 * d21) / denominator;
