@@ -22,5 +22,6 @@ pub mod picture;
 pub mod pipeline;
 pub mod progress;
 pub mod quality;
+pub mod sizing;
 pub mod surface;
 pub mod yplus;

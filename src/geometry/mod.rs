@@ -1,5 +1,6 @@
 //! Geometric vocabulary: the point type and the exact predicates every topological decision uses.
 
+pub mod bvh;
 pub mod distance;
 pub mod grid;
 pub mod intersect;
