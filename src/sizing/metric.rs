@@ -184,7 +184,9 @@ mod tests {
         fn intersection_is_commutative_idempotent_and_restrictive(a in metric(), b in metric(),
                                                                    e in proptest::array::uniform3(-1.0f64..1.0)) {
             let (ab, ba) = (a.intersect(&b), b.intersect(&a));
-            prop_assert!(close(&ab, &ba, 1e-9), "{:?} vs {:?}", ab, ba);
+            // Sizes span four decades, so metric entries span eight: the simultaneous reduction
+            // is exact to about 1e-16 times that condition number.
+            prop_assert!(close(&ab, &ba, 1e-7), "{:?} vs {:?}", ab, ba);
             prop_assert!(close(&a.intersect(&a), &a, 1e-9));
             let e = DVec3::from_array(e);
             let longest = a.edge_length(e).max(b.edge_length(e));
