@@ -51,6 +51,8 @@ pub fn overlapping_pairs(boxes: &[Aabb], is_query: &[bool]) -> Vec<(u32, u32)> {
         })
         .collect();
     entries.par_sort_unstable();
+    // The low cell of each box: the overlap of two boxes starts in the larger of their low cells.
+    let low: Vec<[i64; 3]> = boxes.par_iter().map(|b| cell_of(b.min)).collect();
     let groups: Vec<&[(u64, u32)]> = entries.chunk_by(|a, b| a.0 == b.0).collect();
     let mut pairs: Vec<(u32, u32)> = groups
         .par_iter()
@@ -63,7 +65,8 @@ pub fn overlapping_pairs(boxes: &[Aabb], is_query: &[bool]) -> Vec<(u32, u32)> {
                         continue;
                     }
                     // Report from one cell only.
-                    if key(cell_of(ba.min.max(bb.min))) == k {
+                    let (la, lb) = (low[a as usize], low[b as usize]);
+                    if key([la[0].max(lb[0]), la[1].max(lb[1]), la[2].max(lb[2])]) == k {
                         out.push((a.min(b), a.max(b)));
                     }
                 }
