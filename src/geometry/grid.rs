@@ -14,6 +14,15 @@ const MAX_CELLS_PER_BOX: i64 = 4096;
 /// The pairs `(a, b)`, `a < b`, of overlapping (touching counts) boxes with at least one of them
 /// a query (`is_query[i]`).
 pub fn overlapping_pairs(boxes: &[Aabb], is_query: &[bool]) -> Vec<(u32, u32)> {
+    overlapping_pairs_where(boxes, is_query, |_, _| true)
+}
+
+/// [`overlapping_pairs`] among the pairs that `keep` accepts (tested before any is stored).
+pub fn overlapping_pairs_where(
+    boxes: &[Aabb],
+    is_query: &[bool],
+    keep: impl Fn(u32, u32) -> bool + Sync,
+) -> Vec<(u32, u32)> {
     if boxes.len() < 2 {
         return Vec::new();
     }
@@ -66,7 +75,7 @@ pub fn overlapping_pairs(boxes: &[Aabb], is_query: &[bool]) -> Vec<(u32, u32)> {
                     }
                     // Report from one cell only.
                     let (la, lb) = (low[a as usize], low[b as usize]);
-                    if key([la[0].max(lb[0]), la[1].max(lb[1]), la[2].max(lb[2])]) == k {
+                    if key([la[0].max(lb[0]), la[1].max(lb[1]), la[2].max(lb[2])]) == k && keep(a, b) {
                         out.push((a.min(b), a.max(b)));
                     }
                 }
@@ -79,6 +88,7 @@ pub fn overlapping_pairs(boxes: &[Aabb], is_query: &[bool]) -> Vec<(u32, u32)> {
             if a != b
                 && (is_query[a as usize] || is_query[b as usize])
                 && overlap(&boxes[a as usize], &boxes[b as usize])
+                && keep(a.min(b), a.max(b))
             {
                 pairs.push((a.min(b), a.max(b)));
             }

@@ -16,7 +16,7 @@ use rayon::prelude::*;
 
 use super::topology::{FanScratch, Topology};
 use super::Surface;
-use crate::geometry::grid::overlapping_pairs;
+use crate::geometry::grid::overlapping_pairs_where;
 use crate::geometry::intersect::{folds_over_shared_edge, meet_beyond_shared_vertex, triangles_intersect};
 use crate::geometry::predicates::{orient2d, orient3d, Sign};
 use crate::geometry::{Aabb, DVec3};
@@ -501,9 +501,8 @@ pub fn intersecting_pairs_with(surface: &Surface, queries: &[u32], distant_only:
     for &q in queries {
         is_query[q as usize] = true;
     }
-    overlapping_pairs(&boxes, &is_query)
+    overlapping_pairs_where(&boxes, &is_query, |a, b| !distant_only || !shares_vertex(surface, a, b))
         .into_par_iter()
-        .filter(|&(a, b)| !distant_only || !shares_vertex(surface, a, b))
         .filter(|&(a, b)| triangle_pair_intersects(surface, a, b))
         .collect()
 }
