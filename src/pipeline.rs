@@ -10,7 +10,7 @@ use crate::mesh::{CellKind, VolumeMesh};
 use crate::normals::{self, NormalStats};
 use crate::progress::{Progress, Timings};
 use crate::quality::{self, CheckReport};
-use crate::surface::features::{FeatureCounts, Features};
+use crate::surface::features::{FeatureCounts, Features, VertexKind};
 use crate::surface::topology::Topology;
 use crate::surface::validate::{validate, ValidationError, ValidationOptions};
 use crate::surface::Surface;
@@ -77,6 +77,10 @@ pub struct LayerSummary {
     pub layers_max: u32,
     /// Fraction of layered wall vertices that reached their full stack.
     pub full_coverage: f64,
+    /// The same over the vertices on concave ridges and at concave or saddle corners, and over
+    /// those on convex ridges and at convex or saddle corners (1 when there are none).
+    pub concave_coverage: f64,
+    pub convex_coverage: f64,
     /// Wall vertices whose column stopped before its target, with a few examples.
     pub stopped_vertices: usize,
     pub stopped_examples: Vec<[f64; 3]>,
@@ -135,7 +139,7 @@ pub fn run(
         })
     });
     bar.finish_and_clear();
-    let layer_summary = layer_summary(&layered, &surface);
+    let layer_summary = layer_summary(&layered, &surface, &features);
     let (mesh, core) = if options.core {
         let (mesh, stats) =
             timings.time("core", || fill_core(&layered.mesh, &surface, &CoreOptions::from_config(config)))?;
@@ -192,22 +196,40 @@ fn patch_layer_specs(
         .collect()
 }
 
-fn layer_summary(layered: &layers::Layers, surface: &Surface) -> LayerSummary {
+fn layer_summary(layered: &layers::Layers, surface: &Surface, features: &Features) -> LayerSummary {
     let mut reached: Vec<u32> = layered.vertex_layers.iter().flatten().copied().collect();
     reached.sort_unstable();
-    let full = layered
-        .vertex_layers
-        .iter()
-        .zip(&layered.vertex_target)
-        .filter(|(l, t)| matches!((l, t), (Some(l), Some(t)) if l >= t))
-        .count();
     let pick = |i: usize| reached.get(i).copied().unwrap_or(0);
+    // Fraction of the layered vertices of the given kinds that got their full stack.
+    let coverage = |kinds: &[VertexKind]| {
+        let (mut full, mut all) = (0usize, 0usize);
+        for (v, (l, t)) in layered.vertex_layers.iter().zip(&layered.vertex_target).enumerate() {
+            if let (Some(l), Some(t)) = (l, t) {
+                if kinds.contains(&features.vertex_kind[v]) {
+                    all += 1;
+                    full += usize::from(l >= t);
+                }
+            }
+        }
+        if all == 0 {
+            1.0
+        } else {
+            full as f64 / all as f64
+        }
+    };
+    use VertexKind::*;
     LayerSummary {
         march: layered.stats.clone(),
         layers_min: pick(0),
         layers_median: pick(reached.len() / 2),
         layers_max: reached.last().copied().unwrap_or(0),
-        full_coverage: if reached.is_empty() { 0.0 } else { full as f64 / reached.len() as f64 },
+        full_coverage: if reached.is_empty() {
+            0.0
+        } else {
+            coverage(&[Smooth, ConvexRidge, ConcaveRidge, ConvexCorner, ConcaveCorner, SaddleCorner])
+        },
+        concave_coverage: coverage(&[ConcaveRidge, ConcaveCorner, SaddleCorner]),
+        convex_coverage: coverage(&[ConvexRidge, ConvexCorner, SaddleCorner]),
         stopped_vertices: layered.stopped_vertices.len(),
         stopped_examples: layered
             .stopped_vertices
@@ -236,11 +258,13 @@ impl std::fmt::Display for MeshReport {
         )?;
         writeln!(
             f,
-            "layers    min {} / median {} / max {}; full stack at {:.2}% of wall vertices; {} stopped early",
+            "layers    min {} / median {} / max {}; full stack at {:.2}% of wall vertices ({:.2}% at concave, {:.2}% at convex features); {} stopped early",
             l.layers_min,
             l.layers_median,
             l.layers_max,
             100.0 * l.full_coverage,
+            100.0 * l.concave_coverage,
+            100.0 * l.convex_coverage,
             l.stopped_vertices
         )?;
         writeln!(
