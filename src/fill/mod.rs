@@ -186,20 +186,9 @@ impl PointSizing {
     /// The mean length of the boundary edges at every point (each edge counted once per
     /// triangle using it, so both sides weigh alike).
     pub fn mean_edge_length(boundary: &ClosedBoundary) -> PointSizing {
-        let n = boundary.points.len();
-        let (mut sum, mut count) = (vec![0.0; n], vec![0u32; n]);
-        for t in &boundary.triangles {
-            for i in 0..3 {
-                let (a, b) = (t[i] as usize, t[(i + 1) % 3] as usize);
-                let length = boundary.points[a].distance(boundary.points[b]);
-                for v in [a, b] {
-                    sum[v] += length;
-                    count[v] += 1;
-                }
-            }
+        PointSizing {
+            size: crate::sizing::wall::mean_edge_length_per_vertex(&boundary.points, &boundary.triangles),
         }
-        let size = sum.iter().zip(&count).map(|(s, &c)| if c > 0 { s / c as f64 } else { 0.0 }).collect();
-        PointSizing { size }
     }
 }
 
