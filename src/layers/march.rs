@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::collapse::Merges;
 use super::entropy;
 use super::front::{Columns, Front};
-use super::guard;
+use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Polygon, SlabCell};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -35,6 +35,8 @@ pub struct MarchStats {
     pub steiner_points: usize,
     /// Front edges collapsed where fronts met (two columns merged into one).
     pub collapses: usize,
+    /// Times the crossing guard searched the whole front for candidate pairs.
+    pub guard_rebuilds: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -164,6 +166,7 @@ pub fn march(
     mut on_layer: impl FnMut(u32),
 ) -> MarchStats {
     let mut stats = MarchStats::default();
+    let mut guard = CrossingGuard::default();
     for k in 1..=max_layers {
         for c in 0..columns.len() {
             if columns.alive[c] && distance(c, k).is_none() {
@@ -183,20 +186,67 @@ pub fn march(
                 _ => DVec3::ZERO,
             })
             .collect();
-        let plan = settle_slab(mesh, columns, front, proposed);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut guard, k, &distance);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses;
+        if plan.collapses > 0 || !plan.redirected.is_empty() {
+            guard.invalidate();
+        }
         commit_slab(mesh, columns, front, &plan, &mut stats);
         stats.layers_marched = k;
         on_layer(k);
     }
+    stats.guard_rebuilds = guard.rebuilds;
     stats
+}
+
+/// Where every column will be at the end of the guard's horizon: after layer `k` if the slab
+/// has merged columns (they move to other columns' positions), else after the next
+/// [`LOOKAHEAD_LAYERS`] layers if it keeps moving (or its last layer, if that comes first).
+fn reach(
+    plan: &SlabPlan,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    k: u32,
+    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
+) -> Reach {
+    let committed = mesh.points.len() as u32;
+    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    if plan.collapses > 0 {
+        let end =
+            (0..columns.len() as u32).map(|c| proposal.position(plan.top(c, columns, committed))).collect();
+        return Reach { end, through_layer: k };
+    }
+    let last = k + LOOKAHEAD_LAYERS - 1;
+    let end = (0..columns.len())
+        .into_par_iter()
+        .map(|c| {
+            let node = mesh.points[columns.node[c] as usize];
+            let now = distance(c, k - 1);
+            let ahead = (k..=last).rev().find_map(|j| distance(c, j));
+            match (now, ahead) {
+                (Some(d0), Some(d1)) if plan.moving[c] => {
+                    node + columns.dir[c] * (columns.scale[c] * (d1 - d0))
+                }
+                _ => node,
+            }
+        })
+        .collect();
+    Reach { end, through_layer: last }
 }
 
 /// Decide which columns move and merge so that every cell of the slab is valid and the new
 /// front does not cross itself.
-fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Vec<DVec3>) -> SlabPlan {
+fn settle_slab(
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    proposed: Vec<DVec3>,
+    guard: &mut CrossingGuard,
+    k: u32,
+    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
+) -> SlabPlan {
     let mut plan = SlabPlan {
         moving: columns.alive.clone(),
         proposed,
@@ -211,7 +261,10 @@ fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Ve
         .collect();
     loop {
         repair_invalid_cells(&mut plan, mesh, columns, front, to_check);
-        let crossing = guard::crossing_faces(&plan, mesh, columns, front, &suspects);
+        if guard.is_stale(k, &plan) {
+            guard.rebuild(&plan, mesh, columns, front, reach(&plan, mesh, columns, k, distance));
+        }
+        let crossing = guard.crossing_faces(&plan, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
         for f in crossing {
             tracing::debug!(face = f, "the new front crosses itself: stopping the face's columns");
@@ -295,20 +348,27 @@ fn commit_slab(
             }
         })
         .collect();
-    for f in 0..front.len() {
-        let cols = front.face_columns(f);
-        let n = cols.len();
-        let mut b = [0; 4];
-        let mut t = [0; 4];
-        for (i, &c) in cols.iter().enumerate() {
-            b[i] = columns.node[c as usize];
-            t[i] = top[c as usize];
-        }
-        if b[..n] != t[..n] {
+    // The cells are decided in parallel, then emitted in face order (deterministic output).
+    let cells: Vec<(bool, SlabCell)> = (0..front.len())
+        .into_par_iter()
+        .map(|f| {
+            let cols = front.face_columns(f);
+            let n = cols.len();
+            let mut b = [0; 4];
+            let mut t = [0; 4];
+            for (i, &c) in cols.iter().enumerate() {
+                b[i] = columns.node[c as usize];
+                t[i] = top[c as usize];
+            }
+            (b[..n] != t[..n], slab_cell(&b[..n], &t[..n]))
+        })
+        .collect();
+    for (f, (moved, cell)) in cells.into_iter().enumerate() {
+        if moved {
             // The top is now front, even under a flat cell whose top lies on a neighbour's face.
             front.raise(f);
         }
-        emit_cell(mesh, slab_cell(&b[..n], &t[..n]), stats);
+        emit_cell(mesh, cell, stats);
     }
     for c in 0..columns.len() {
         let r = plan.merges.root(c as u32) as usize;
