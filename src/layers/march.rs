@@ -156,22 +156,29 @@ fn face_nodes(
 
 /// March `layers` steps (or until every column has stopped), appending points and cells to
 /// `mesh`. `distance(c, k)` is how far column `c` should be from the wall after `k` layers, or
-/// `None` when its stack is complete.
+/// `None` when its stack is complete. Columns with `stop_when_isotropic[c]` also end their stack
+/// before the first layer whose height would reach the front's edge length around them
+/// (`count = "auto"`); they are marked in `columns.isotropic_ratio`.
 pub fn march(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
     max_layers: u32,
     distance: impl Fn(usize, u32) -> Option<f64> + Sync,
+    stop_when_isotropic: &[bool],
     mut on_layer: impl FnMut(u32),
 ) -> MarchStats {
     let mut stats = MarchStats::default();
     let mut guard = CrossingGuard::default();
+    let wall_size = front.mean_edge_length_at_columns(&mesh.points, columns);
     for k in 1..=max_layers {
         for c in 0..columns.len() {
             if columns.alive[c] && distance(c, k).is_none() {
                 columns.alive[c] = false;
             }
+        }
+        if stop_when_isotropic.iter().any(|&s| s) {
+            stop_isotropic_columns(mesh, columns, front, k, &distance, stop_when_isotropic, &wall_size);
         }
         if !columns.alive.iter().any(|&a| a) {
             break;
@@ -199,6 +206,67 @@ pub fn march(
     }
     stats.guard_rebuilds = guard.rebuilds;
     stats
+}
+
+/// End the stacks of the columns whose next layer (the `k`-th) would be at least as high as the
+/// front's tangential size around them ([`Front::mean_edge_length_at_columns`]): its cells would
+/// be isotropic, which the core's tetrahedra do better. Where the front widens faster than the
+/// layers grow (convex walls coarser than the growth rate can follow, until tangential
+/// refinement splits their edges), the wall's own tangential size `wall_size` ends the stack
+/// instead.
+fn stop_isotropic_columns(
+    mesh: &VolumeMesh,
+    columns: &mut Columns,
+    front: &Front,
+    k: u32,
+    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
+    stop_when_isotropic: &[bool],
+    wall_size: &[f64],
+) {
+    let edge = front.mean_edge_length_at_columns(&mesh.points, columns);
+    let ended = ended_neighbour_layers(columns, front);
+    let ends = |c: usize| {
+        let (Some(d), Some(d_before)) = (distance(c, k), distance(c, k - 1)) else { return false };
+        // A neighbour's stack ended more than one layer lower: end here too, so that the stacks
+        // step down one layer at a time (no cliff in the final front).
+        let cliff = ended[c] < columns.layers[c];
+        cliff || d - d_before >= edge[c].min(wall_size[c])
+    };
+    let candidates: Vec<bool> =
+        (0..columns.len()).map(|c| columns.alive[c] && stop_when_isotropic[c]).collect();
+    // The columns of one wall vertex (a fan) end together: a fan strip cell with one side
+    // stopped and the other moving would be flat.
+    let mut vertex_ends = vec![false; columns.wall_vertex.iter().max().map_or(0, |&v| v as usize + 1)];
+    for c in (0..columns.len()).filter(|&c| candidates[c] && ends(c)) {
+        vertex_ends[columns.wall_vertex[c] as usize] = true;
+    }
+    for c in 0..columns.len() {
+        if candidates[c] && vertex_ends[columns.wall_vertex[c] as usize] {
+            columns.alive[c] = false;
+            // The last layer built, against the tangential size it ended at.
+            let (d_before, d_last) =
+                (distance(c, k - 1).unwrap_or(0.0), k.checked_sub(2).and_then(|j| distance(c, j)));
+            columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / edge[c];
+        }
+    }
+}
+
+/// For every column, the fewest layers of a neighbour (across a front edge) whose stack ended at
+/// isotropy (`u32::MAX` if none).
+fn ended_neighbour_layers(columns: &Columns, front: &Front) -> Vec<u32> {
+    let mut fewest = vec![u32::MAX; columns.len()];
+    for f in 0..front.len() {
+        let cols = front.face_columns(f);
+        for i in 0..cols.len() {
+            let (a, b) = (cols[i] as usize, cols[(i + 1) % cols.len()] as usize);
+            for (c, n) in [(a, b), (b, a)] {
+                if !columns.isotropic_ratio[n].is_nan() {
+                    fewest[c] = fewest[c].min(columns.layers[n]);
+                }
+            }
+        }
+    }
+    fewest
 }
 
 /// Where every column will be at the end of the guard's horizon: after layer `k` if the slab
@@ -379,6 +447,11 @@ fn commit_slab(
             columns.merged_into[c] = r as u32;
             columns.node[c] = top[c];
         } else {
+            record_step(
+                columns,
+                c,
+                mesh.points[columns.node[c] as usize].distance(mesh.points[top[c] as usize]),
+            );
             columns.node[c] = top[c];
             columns.layers[c] += 1;
         }
@@ -390,6 +463,19 @@ fn commit_slab(
     if plan.collapses > 0 {
         front.apply_merges(plan.merges.roots());
     }
+}
+
+/// Remember column `c`'s new step and how it compares with the one before.
+fn record_step(columns: &mut Columns, c: usize, step: f64) {
+    let before = columns.last_step[c];
+    if before > 0.0 && step > 0.0 {
+        let ratio = step / before;
+        let worst = columns.max_step_ratio[c];
+        if worst == 0.0 || ratio.ln().abs() > worst.ln().abs() {
+            columns.max_step_ratio[c] = ratio;
+        }
+    }
+    columns.last_step[c] = step;
 }
 
 fn emit_cell(mesh: &mut VolumeMesh, cell: SlabCell, stats: &mut MarchStats) {
