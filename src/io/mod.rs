@@ -276,6 +276,17 @@ mod tests {
     }
 
     #[test]
+    fn cgns_output_is_available_exactly_with_the_feature() {
+        let format = MeshFormat::from_path(Path::new("out.CGNS"), false);
+        assert_eq!(format, Some(MeshFormat::Cgns));
+        assert_eq!(MeshFormat::Cgns.unavailable().is_some(), !cfg!(feature = "cgns"));
+        if let Some(why) = MeshFormat::Cgns.unavailable() {
+            assert!(why.contains("--features cgns"), "{why}");
+        }
+        assert_eq!(MeshFormat::Su2.unavailable(), None);
+    }
+
+    #[test]
     fn unknown_extension_is_a_clear_error() {
         let e = read_surface(Path::new("body.xyz")).unwrap_err();
         assert!(e.to_string().contains("unknown file type"), "{e}");

@@ -3,9 +3,10 @@
 //!
 //! A file has one base (`Base`, 3D) and one unstructured zone (`Zone`): the coordinates, one
 //! `MIXED` element section per volume zone of the mesh (named after it: `layers`, `core`, ...),
-//! then one face section per boundary patch (named after it; `TRI_3`, `QUAD_4` or `MIXED`) with a
-//! boundary condition of the same name on that element range (`PointRange` at `FaceCenter`) whose
-//! type comes from the patch role ([`BcType::for_role`]). Cells keep our node orders, which are
+//! then the faces of each boundary patch: a `TRI_3` section named after it and a `QUAD_4` one
+//! (`<patch>_quads` when it has both), with a boundary condition of the patch's name on their
+//! element range (`PointRange` at `FaceCenter`) whose type comes from the patch role
+//! ([`BcType::for_role`]). Cells keep our node orders, which are
 //! the CGNS ones ([`crate::mesh`]). Node names are at most 32 characters: longer patch names are
 //! cut, and names that would repeat get a `_2`, `_3`... suffix.
 

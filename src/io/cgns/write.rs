@@ -55,13 +55,17 @@ pub(super) fn write_file(path: &Path, mesh: &VolumeMesh, roles: &[Role]) -> Resu
     for section in &cells {
         next = write_section(&mut file, (b, z), section, next)?;
     }
-    for (patch, section) in &patches {
+    for (patch, parts) in &patches {
         let first = next;
-        next = write_section(&mut file, (b, z), section, next)?;
+        for section in parts {
+            next = write_section(&mut file, (b, z), section, next)?;
+        }
         let name = mesh.patch_names.get(*patch).map_or("", String::as_str);
         let role = roles.get(*patch).copied().unwrap_or_else(|| default_role(name));
         let range = [first, next - 1];
-        file.write_face_boco((b, z), &section.name, BcType::for_role(role).code(), ffi::POINT_RANGE, &range)?;
+        // Named like the patch's first section: valid, unique and short.
+        let bc_name = &parts[0].name;
+        file.write_face_boco((b, z), bc_name, BcType::for_role(role).code(), ffi::POINT_RANGE, &range)?;
     }
     file.close()
 }
@@ -104,30 +108,48 @@ fn cell_sections(mesh: &VolumeMesh, names: &mut UniqueNames) -> Result<Vec<Secti
     Ok(sections.into_iter().flatten().collect())
 }
 
-/// One face section per patch that has faces, with its patch index.
+/// The face sections of every patch that has faces, with its patch index: its triangles
+/// (`TRI_3`, named after the patch), then its quads (`QUAD_4`, named `<patch>_quads` when the
+/// patch also has triangles), so that one element range covers the patch. Fixed-type sections
+/// rather than MIXED: cgnscheck 3.4 looks up faces in MIXED face sections with the node count of
+/// the element before, and some readers take boundary sections of one type only.
 fn patch_sections(
     mesh: &VolumeMesh,
     names: &mut UniqueNames,
-) -> Result<Vec<(usize, SectionData)>, CgnsError> {
+) -> Result<Vec<(usize, Vec<SectionData>)>, CgnsError> {
     let b = &mesh.boundary;
     let patch_count =
         b.triangle_patch.iter().chain(&b.quad_patch).map(|&p| p as usize + 1).max().unwrap_or(0);
-    let mut faces: Vec<Vec<(i32, &[u32])>> = vec![Vec::new(); patch_count];
-    let triangles = b.triangles.iter().map(|t| (TRI_3, &t[..])).zip(&b.triangle_patch);
-    let quads = b.quads.iter().map(|q| (QUAD_4, &q[..])).zip(&b.quad_patch);
-    for (face, &patch) in triangles.chain(quads) {
-        faces[patch as usize].push(face);
+    let mut faces: Vec<[Vec<&[u32]>; 2]> = vec![[Vec::new(), Vec::new()]; patch_count];
+    for (t, &patch) in b.triangles.iter().zip(&b.triangle_patch) {
+        faces[patch as usize][0].push(&t[..]);
+    }
+    for (q, &patch) in b.quads.iter().zip(&b.quad_patch) {
+        faces[patch as usize][1].push(&q[..]);
     }
     let mut sections = Vec::new();
-    for (patch, faces) in faces.into_iter().enumerate().filter(|(_, f)| !f.is_empty()) {
-        let uniform = faces.iter().all(|f| f.0 == faces[0].0);
-        let name = names.take(mesh.patch_names.get(patch).map(String::as_str), "patch", patch);
-        let element_type = if uniform { faces[0].0 } else { MIXED };
-        let mut section = SectionData::new(name, element_type);
-        for (face_type, nodes) in faces {
-            push_element(&mut section, face_type, nodes)?;
+    for (patch, [triangles, quads]) in faces.into_iter().enumerate() {
+        let name = mesh.patch_names.get(patch).map(String::as_str);
+        let mut parts = Vec::new();
+        for (element_type, faces) in [(TRI_3, triangles), (QUAD_4, quads)] {
+            if faces.is_empty() {
+                continue;
+            }
+            let section_name = match (element_type, parts.is_empty()) {
+                (QUAD_4, false) => {
+                    names.take(name.map(|n| format!("{n}_quads")).as_deref(), "patch_quads", patch)
+                }
+                _ => names.take(name, "patch", patch),
+            };
+            let mut section = SectionData::new(section_name, element_type);
+            for nodes in faces {
+                push_element(&mut section, element_type, nodes)?;
+            }
+            parts.push(section);
         }
-        sections.push((patch, section));
+        if !parts.is_empty() {
+            sections.push((patch, parts));
+        }
     }
     Ok(sections)
 }
