@@ -10,19 +10,14 @@ points with 6 significant digits, so the total volume is compared within 1e-4 re
 usage: cgns_vtk.py FILE.vtk --expect TYPE=N [--expect ...] --volume V
 """
 import argparse
+import os
 import sys
 
 import meshio
 import numpy as np
 
-# Outward faces of the CGNS (= Gmsh = meshio) node orders, as in interop.py.
-FACES = {
-    "tetra": [(0, 2, 1), (0, 1, 3), (1, 2, 3), (0, 3, 2)],
-    "pyramid": [(0, 3, 2, 1), (0, 1, 4), (1, 2, 4), (2, 3, 4), (3, 0, 4)],
-    "wedge": [(0, 2, 1), (3, 4, 5), (0, 1, 4, 3), (1, 2, 5, 4), (2, 0, 3, 5)],
-    "hexahedron": [(0, 3, 2, 1), (4, 5, 6, 7), (0, 1, 5, 4), (1, 2, 6, 5), (2, 3, 7, 6),
-                   (3, 0, 4, 7)],
-}
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from interop import FACES  # noqa: E402  (outward faces of the Gmsh = meshio = CGNS orders)
 
 
 def sub_volumes(x, faces):
