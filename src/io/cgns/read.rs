@@ -35,6 +35,23 @@ pub(super) fn read_file(path: &Path) -> Result<CgnsFile, CgnsError> {
     }
     let points = (0..vertex_count).map(|i| DVec3::new(axes[0][i], axes[1][i], axes[2][i])).collect();
     let mut mesh = VolumeMesh { points, ..Default::default() };
+    let (sections, faces) = read_sections(&mut file, &mut mesh, budget)?;
+    let boundary_conditions = read_boundary(&mut file, &mut mesh, &faces, &sections, budget)?;
+    file.close()?;
+    // Compared with what the sections hold by the caller; refused only when negative.
+    let zone_cells =
+        usize::try_from(cells).map_err(|_| CgnsError::new(format!("the zone has {cells} cells")))?;
+    Ok(CgnsFile { zone_vertices: vertex_count, zone_cells, mesh, sections, boundary_conditions })
+}
+
+/// Every element section: cells into `mesh` (a volume zone per section that has cells), faces
+/// returned for the boundary conditions.
+fn read_sections(
+    file: &mut File,
+    mesh: &mut VolumeMesh,
+    budget: u64,
+) -> Result<(Vec<Section>, Vec<Face>), CgnsError> {
+    let (b, z) = (1, 1);
     let mut sections = Vec::new();
     let mut faces = Vec::new();
     for s in 1..=file.section_count(b, z)? {
@@ -46,16 +63,20 @@ pub(super) fn read_file(path: &Path) -> Result<CgnsFile, CgnsError> {
             _ => None,
         };
         let data = file.read_elements((b, z, s), mixed_count, len)?;
-        let elements = parse_elements(&header, &data, vertex_count)?;
+        let elements = parse_elements(&header, &data, mesh.points.len())?;
         let zone = mesh.zone_names.len() as u32;
         let mut has_cells = false;
-        for ((element_type, nodes), number) in elements.iter().zip(header.start..) {
+        for (i, (element_type, nodes)) in elements.iter().enumerate() {
             match CellKind::from_cgns_type(*element_type) {
                 Some(kind) => {
                     mesh.push_cell(kind, nodes, zone);
                     has_cells = true;
                 }
-                None => faces.push(Face { number, nodes: nodes.clone(), section: sections.len() }),
+                None => {
+                    // Within start..=end: parse_elements checked the count.
+                    let number = header.start + i as CgSize;
+                    faces.push(Face { number, nodes: nodes.clone(), section: sections.len() });
+                }
             }
         }
         if has_cells {
@@ -67,12 +88,7 @@ pub(super) fn read_file(path: &Path) -> Result<CgnsFile, CgnsError> {
             elements: elements.len(),
         });
     }
-    let boundary_conditions = read_boundary(&mut file, &mut mesh, &faces, &sections, budget)?;
-    file.close()?;
-    // Compared with what the sections hold by the caller; refused only when negative.
-    let zone_cells =
-        usize::try_from(cells).map_err(|_| CgnsError::new(format!("the zone has {cells} cells")))?;
-    Ok(CgnsFile { zone_vertices: vertex_count, zone_cells, mesh, sections, boundary_conditions })
+    Ok((sections, faces))
 }
 
 /// Check that base 1 is 3D and has exactly one zone, unstructured.
@@ -119,13 +135,13 @@ fn parse_elements(
 ) -> Result<Vec<(i32, Vec<u32>)>, CgnsError> {
     let name = &header.name;
     let error = |message: String| CgnsError::new(format!("section {name}: {message}"));
-    let expected = i64::from(header.end) - i64::from(header.start) + 1;
+    let expected = element_count(header)?;
     let mut elements = Vec::new();
     let mut rest = data;
     while !rest.is_empty() {
-        let number = i64::from(header.start) + elements.len() as i64;
+        let number = i64::from(header.start).saturating_add(elements.len() as i64);
         let (element_type, body) = match (header.element_type, rest) {
-            (MIXED, [t, body @ ..]) => (i32::try_from(*t).unwrap_or(-1), body),
+            (MIXED, [t, body @ ..]) => (element_type_of(*t), body),
             (t, body) => (t, body),
         };
         let npe = nodes_per_element(element_type).ok_or_else(|| {
@@ -147,7 +163,7 @@ fn parse_elements(
         elements.push((element_type, nodes));
         rest = &body[npe..];
     }
-    if elements.len() as i64 != expected {
+    if CgSize::try_from(elements.len()).ok() != Some(expected) {
         return Err(error(format!(
             "{} elements for the range {}..{}",
             elements.len(),
@@ -156,6 +172,12 @@ fn parse_elements(
         )));
     }
     Ok(elements)
+}
+
+/// An `ElementType_t` stored in a connectivity array (-1, unknown, when out of range).
+#[allow(clippy::useless_conversion)] // `CgSize` is `i64` in a 64-bit CGNS build.
+fn element_type_of(value: CgSize) -> i32 {
+    i32::try_from(value).unwrap_or(-1)
 }
 
 fn nodes_per_element(element_type: i32) -> Option<usize> {
@@ -245,7 +267,9 @@ fn face_numbers(
         return Ok(points.to_vec());
     }
     match *points {
-        [first, last] if first <= last && (i64::from(last) - i64::from(first)) < face_count as i64 => {
+        [first, last]
+            if last.checked_sub(first).is_some_and(|d| d >= 0 && (d as u64) < face_count as u64) =>
+        {
             Ok((first..=last).collect())
         }
         _ => Err(error(format!("range {points:?} is not within the file's {face_count} faces"))),
