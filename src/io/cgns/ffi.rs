@@ -39,151 +39,49 @@ pub const ELEMENT_LIST: c_int = 7;
 /// Node names are at most 32 characters (`char name[33]` with the terminator).
 pub const NAME_LEN: usize = 32;
 
-// Linked by build.rs (feature `cgns`).
+// Linked by build.rs (feature `cgns`). Declarations as in cgnslib.h 3.4 (enums are `int`).
+#[rustfmt::skip]
 extern "C" {
     fn cg_set_file_type(file_type: c_int) -> c_int;
     fn cg_open(filename: *const c_char, mode: c_int, fn_: *mut c_int) -> c_int;
     fn cg_close(fn_: c_int) -> c_int;
     fn cg_get_error() -> *const c_char;
-    fn cg_base_write(
-        fn_: c_int,
-        name: *const c_char,
-        cell_dim: c_int,
-        phys_dim: c_int,
-        b: *mut c_int,
-    ) -> c_int;
     fn cg_gopath(fn_: c_int, path: *const c_char) -> c_int;
     fn cg_dataclass_write(data_class: c_int) -> c_int;
     fn cg_exponents_write(data_type: c_int, exponents: *const c_void) -> c_int;
+    fn cg_base_write(fn_: c_int, name: *const c_char, cell_dim: c_int, phys_dim: c_int, b: *mut c_int) -> c_int;
     fn cg_nbases(fn_: c_int, n: *mut c_int) -> c_int;
-    fn cg_base_read(
-        fn_: c_int,
-        b: c_int,
-        name: *mut c_char,
-        cell_dim: *mut c_int,
-        phys_dim: *mut c_int,
-    ) -> c_int;
-    fn cg_zone_write(
-        fn_: c_int,
-        b: c_int,
-        name: *const c_char,
-        size: *const CgSize,
-        zone_type: c_int,
-        z: *mut c_int,
-    ) -> c_int;
+    fn cg_base_read(fn_: c_int, b: c_int, name: *mut c_char, cell_dim: *mut c_int, phys_dim: *mut c_int) -> c_int;
+    fn cg_zone_write(fn_: c_int, b: c_int, name: *const c_char, size: *const CgSize, zone_type: c_int,
+        z: *mut c_int) -> c_int;
     fn cg_nzones(fn_: c_int, b: c_int, n: *mut c_int) -> c_int;
     fn cg_zone_type(fn_: c_int, b: c_int, z: c_int, zone_type: *mut c_int) -> c_int;
     fn cg_zone_read(fn_: c_int, b: c_int, z: c_int, name: *mut c_char, size: *mut CgSize) -> c_int;
-    fn cg_coord_write(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        data_type: c_int,
-        name: *const c_char,
-        data: *const c_void,
-        c: *mut c_int,
-    ) -> c_int;
-    fn cg_coord_read(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        name: *const c_char,
-        data_type: c_int,
-        rmin: *const CgSize,
-        rmax: *const CgSize,
-        data: *mut c_void,
-    ) -> c_int;
-    fn cg_section_write(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        name: *const c_char,
-        element_type: c_int,
-        start: CgSize,
-        end: CgSize,
-        nbndry: c_int,
-        elements: *const CgSize,
-        s: *mut c_int,
-    ) -> c_int;
-    fn cg_poly_section_write(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        name: *const c_char,
-        element_type: c_int,
-        start: CgSize,
-        end: CgSize,
-        nbndry: c_int,
-        elements: *const CgSize,
-        offsets: *const CgSize,
-        s: *mut c_int,
-    ) -> c_int;
-    fn cg_poly_elements_read(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        s: c_int,
-        elements: *mut CgSize,
-        offsets: *mut CgSize,
-        parent_data: *mut CgSize,
-    ) -> c_int;
+    fn cg_coord_write(fn_: c_int, b: c_int, z: c_int, data_type: c_int, name: *const c_char,
+        data: *const c_void, c: *mut c_int) -> c_int;
+    fn cg_coord_read(fn_: c_int, b: c_int, z: c_int, name: *const c_char, data_type: c_int,
+        rmin: *const CgSize, rmax: *const CgSize, data: *mut c_void) -> c_int;
+    fn cg_section_write(fn_: c_int, b: c_int, z: c_int, name: *const c_char, element_type: c_int,
+        start: CgSize, end: CgSize, nbndry: c_int, elements: *const CgSize, s: *mut c_int) -> c_int;
+    fn cg_poly_section_write(fn_: c_int, b: c_int, z: c_int, name: *const c_char, element_type: c_int,
+        start: CgSize, end: CgSize, nbndry: c_int, elements: *const CgSize, offsets: *const CgSize,
+        s: *mut c_int) -> c_int;
     fn cg_nsections(fn_: c_int, b: c_int, z: c_int, n: *mut c_int) -> c_int;
-    fn cg_section_read(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        s: c_int,
-        name: *mut c_char,
-        element_type: *mut c_int,
-        start: *mut CgSize,
-        end: *mut CgSize,
-        nbndry: *mut c_int,
-        parent_flag: *mut c_int,
-    ) -> c_int;
+    fn cg_section_read(fn_: c_int, b: c_int, z: c_int, s: c_int, name: *mut c_char, element_type: *mut c_int,
+        start: *mut CgSize, end: *mut CgSize, nbndry: *mut c_int, parent_flag: *mut c_int) -> c_int;
     fn cg_ElementDataSize(fn_: c_int, b: c_int, z: c_int, s: c_int, size: *mut CgSize) -> c_int;
-    fn cg_elements_read(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        s: c_int,
-        elements: *mut CgSize,
-        parent_data: *mut CgSize,
-    ) -> c_int;
-    fn cg_boco_write(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        name: *const c_char,
-        bc_type: c_int,
-        point_set_type: c_int,
-        npnts: CgSize,
-        pnts: *const CgSize,
-        bc: *mut c_int,
-    ) -> c_int;
+    fn cg_elements_read(fn_: c_int, b: c_int, z: c_int, s: c_int, elements: *mut CgSize,
+        parent_data: *mut CgSize) -> c_int;
+    fn cg_poly_elements_read(fn_: c_int, b: c_int, z: c_int, s: c_int, elements: *mut CgSize,
+        offsets: *mut CgSize, parent_data: *mut CgSize) -> c_int;
+    fn cg_boco_write(fn_: c_int, b: c_int, z: c_int, name: *const c_char, bc_type: c_int,
+        point_set_type: c_int, npnts: CgSize, pnts: *const CgSize, bc: *mut c_int) -> c_int;
     fn cg_boco_gridlocation_write(fn_: c_int, b: c_int, z: c_int, bc: c_int, location: c_int) -> c_int;
     fn cg_nbocos(fn_: c_int, b: c_int, z: c_int, n: *mut c_int) -> c_int;
-    fn cg_boco_info(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        bc: c_int,
-        name: *mut c_char,
-        bc_type: *mut c_int,
-        point_set_type: *mut c_int,
-        npnts: *mut CgSize,
-        normal_index: *mut c_int,
-        normal_list_size: *mut CgSize,
-        normal_data_type: *mut c_int,
-        ndataset: *mut c_int,
-    ) -> c_int;
-    fn cg_boco_read(
-        fn_: c_int,
-        b: c_int,
-        z: c_int,
-        bc: c_int,
-        pnts: *mut CgSize,
-        normals: *mut c_void,
-    ) -> c_int;
+    fn cg_boco_info(fn_: c_int, b: c_int, z: c_int, bc: c_int, name: *mut c_char, bc_type: *mut c_int,
+        point_set_type: *mut c_int, npnts: *mut CgSize, normal_index: *mut c_int,
+        normal_list_size: *mut CgSize, normal_data_type: *mut c_int, ndataset: *mut c_int) -> c_int;
+    fn cg_boco_read(fn_: c_int, b: c_int, z: c_int, bc: c_int, pnts: *mut CgSize, normals: *mut c_void) -> c_int;
     fn cg_boco_gridlocation_read(fn_: c_int, b: c_int, z: c_int, bc: c_int, location: *mut c_int) -> c_int;
 }
 
