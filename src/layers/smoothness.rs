@@ -7,7 +7,6 @@ use serde::Serialize;
 
 use super::front::Columns;
 use crate::mesh::VolumeMesh;
-use crate::surface::topology::Topology;
 use crate::surface::Surface;
 
 /// A distribution of ratios: quantiles, the largest, and the fraction within a tolerance band.
@@ -59,9 +58,15 @@ pub struct Smoothness {
 /// Measure the layers' smoothness. `growth` is the (largest) growth ratio, for the bands.
 pub fn measure(surface: &Surface, mesh: &VolumeMesh, columns: &Columns, growth: f64) -> Smoothness {
     let thickness = vertex_thickness(surface, mesh, columns);
-    let topology = Topology::new(surface);
-    let neighbour: Vec<f64> = topology
-        .edges
+    let mut edges: Vec<[u32; 2]> = surface
+        .triangles
+        .iter()
+        .flat_map(|t| [[t[0], t[1]], [t[1], t[2]], [t[2], t[0]]])
+        .map(|[a, b]| [a.min(b), a.max(b)])
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let neighbour: Vec<f64> = edges
         .iter()
         .filter_map(|e| {
             let (a, b) = (thickness[e[0] as usize]?, thickness[e[1] as usize]?);
