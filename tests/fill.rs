@@ -113,6 +113,11 @@ fn fill_and_check(
         stats.seconds,
         stats.mesher_seconds
     );
+    let q = &stats.quality;
+    eprintln!(
+        "{name}: TetGen min dihedral {:.2}, after improvement {:.2} ({:?}); histogram {}; below 10: {:?}",
+        q.mesher_min_dihedral, q.min_dihedral, q.improvement, q.histogram, q.slivers
+    );
     stats
 }
 
@@ -200,5 +205,56 @@ fn spot_with_20_layers_fills_or_reports_the_crossing_front() {
         }
         Err(e @ FillError::SelfIntersecting { .. }) => eprintln!("spot, 20 layers: {e}"),
         Err(e) => panic!("spot, 20 layers: {e}"),
+    }
+}
+
+/// Diagnostic (run by hand): the worst tetrahedra left after the improvement on a surface
+/// (`BLMESH_SURFACE`, default spot), with what each operator could do on them.
+#[test]
+#[ignore = "diagnostic"]
+fn worst_core_tetrahedra() {
+    use blmesh::fill::improve::{min_dihedral, ImproveOptions, TetMesh};
+    use blmesh::fill::{fill_core_with, tetgen::TetGen, ClosedBoundary, CoreMesher, CoreTets, PointSizing};
+    use std::cell::RefCell;
+    struct Capture(RefCell<Option<(ClosedBoundary, CoreTets)>>);
+    impl CoreMesher for Capture {
+        fn fill(&self, b: &ClosedBoundary, s: &PointSizing) -> Result<CoreTets, FillError> {
+            let t = TetGen::default().fill(b, s)?;
+            *self.0.borrow_mut() = Some((b.clone(), t.clone()));
+            Ok(t)
+        }
+    }
+    let name = std::env::var("BLMESH_SURFACE").unwrap_or_else(|_| "spot.obj".into());
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/geometries").join(&name);
+    let wall = blmesh::io::read_surface(&path).unwrap();
+    let layers = layered(&wall, &Config::default());
+    let capture = Capture(RefCell::new(None));
+    let options = CoreOptions { improve: ImproveOptions { passes: 0, ..Default::default() }, ..Default::default() };
+    fill_core_with(&capture, &layers, &wall, &options).unwrap();
+    let (boundary, core) = capture.0.into_inner().unwrap();
+    let fixed = boundary.points.len();
+    let mut mesh = TetMesh::new(core.points, core.tets, fixed);
+    let stats = mesh.improve(&ImproveOptions::default());
+    eprintln!("{stats:?}");
+    let q = |m: &TetMesh, t: [u32; 4]| min_dihedral(t.map(|v| m.points[v as usize]));
+    let mut worst: Vec<[u32; 4]> = mesh.tets().filter(|&t| q(&mesh, t) < 2.0).collect();
+    worst.sort_by(|a, b| q(&mesh, *a).total_cmp(&q(&mesh, *b)));
+    for t in worst.iter().take(6) {
+        eprintln!("tet {t:?} q {:.2}", q(&mesh, *t));
+        for v in t {
+            let ball: Vec<f64> = mesh.tets().filter(|s| s.contains(v)).map(|s| q(&mesh, s)).collect();
+            let mut ball = ball;
+            ball.sort_by(f64::total_cmp);
+            eprintln!("  node {v} fixed {} at {:?} ball worst {:?}", (*v as usize) < fixed, mesh.points[*v as usize], &ball[..ball.len().min(4)]);
+        }
+        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+            let ring = mesh.ring(t[i], t[j]).map(|r| r.1.len());
+            let rem = mesh.remove_edge(t[i], t[j]).map(|c| (c.before, c.after));
+            let split = mesh.split_edge(t[i], t[j]).map(|c| (c.before, c.after));
+            eprintln!("  edge {i}{j}: ring {ring:?} removal {rem:?} split {split:?}");
+        }
+        for v in t {
+            eprintln!("  smooth {v}: {:?}", mesh.smooth_vertex(*v).map(|c| (c.before, c.after)));
+        }
     }
 }
