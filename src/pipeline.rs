@@ -297,7 +297,9 @@ impl std::fmt::Display for MeshReport {
                 )?;
                 writeln!(f, "          min dihedral per tetrahedron (deg): {}", q.histogram)?;
             }
-            None => writeln!(f, "core      not built (--no-core): the layers' top faces are the patch bl_top")?,
+            None => {
+                writeln!(f, "core      not built (--no-core): the layers' top faces are the patch bl_top")?
+            }
         }
         writeln!(f, "quality   worst scaled Jacobian {:.3}", worst_scaled_jacobian(&self.check))?;
         for w in &self.warnings {

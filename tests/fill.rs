@@ -213,7 +213,7 @@ fn spot_with_20_layers_fills_or_reports_the_crossing_front() {
 #[test]
 #[ignore = "diagnostic"]
 fn worst_core_tetrahedra() {
-    use blmesh::fill::improve::{min_dihedral, ImproveOptions, TetMesh};
+    use blmesh::fill::improve::{angle_quality, ImproveOptions, TetMesh};
     use blmesh::fill::{fill_core_with, tetgen::TetGen, ClosedBoundary, CoreMesher, CoreTets, PointSizing};
     use std::cell::RefCell;
     struct Capture(RefCell<Option<(ClosedBoundary, CoreTets)>>);
@@ -226,18 +226,26 @@ fn worst_core_tetrahedra() {
     }
     let name = std::env::var("BLMESH_SURFACE").unwrap_or_else(|_| "spot.obj".into());
     let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/geometries").join(&name);
-    let wall = blmesh::io::read_surface(&path).unwrap();
-    let layers = layered(&wall, &Config::default());
+    let (wall, cfg) = match name.as_str() {
+        "box" => {
+            let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
+            let cfg = config(&wall, 20);
+            (wall, cfg)
+        }
+        _ => (blmesh::io::read_surface(&path).unwrap(), Config::default()),
+    };
+    let layers = layered(&wall, &cfg);
     let capture = Capture(RefCell::new(None));
-    let options = CoreOptions { improve: ImproveOptions { passes: 0, ..Default::default() }, ..Default::default() };
+    let options =
+        CoreOptions { improve: ImproveOptions { passes: 0, ..Default::default() }, ..Default::default() };
     fill_core_with(&capture, &layers, &wall, &options).unwrap();
     let (boundary, core) = capture.0.into_inner().unwrap();
     let fixed = boundary.points.len();
     let mut mesh = TetMesh::new(core.points, core.tets, fixed);
     let stats = mesh.improve(&ImproveOptions::default());
     eprintln!("{stats:?}");
-    let q = |m: &TetMesh, t: [u32; 4]| min_dihedral(t.map(|v| m.points[v as usize]));
-    let mut worst: Vec<[u32; 4]> = mesh.tets().filter(|&t| q(&mesh, t) < 2.0).collect();
+    let q = |m: &TetMesh, t: [u32; 4]| angle_quality(t.map(|v| m.points[v as usize]));
+    let mut worst: Vec<[u32; 4]> = mesh.tets().filter(|&t| q(&mesh, t) < 10.0).collect();
     worst.sort_by(|a, b| q(&mesh, *a).total_cmp(&q(&mesh, *b)));
     for t in worst.iter().take(6) {
         eprintln!("tet {t:?} q {:.2}", q(&mesh, *t));
@@ -245,7 +253,12 @@ fn worst_core_tetrahedra() {
             let ball: Vec<f64> = mesh.tets().filter(|s| s.contains(v)).map(|s| q(&mesh, s)).collect();
             let mut ball = ball;
             ball.sort_by(f64::total_cmp);
-            eprintln!("  node {v} fixed {} at {:?} ball worst {:?}", (*v as usize) < fixed, mesh.points[*v as usize], &ball[..ball.len().min(4)]);
+            eprintln!(
+                "  node {v} fixed {} at {:?} ball worst {:?}",
+                (*v as usize) < fixed,
+                mesh.points[*v as usize],
+                &ball[..ball.len().min(4)]
+            );
         }
         for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
             let ring = mesh.ring(t[i], t[j]).map(|r| r.1.len());

@@ -18,14 +18,17 @@ use std::time::Instant;
 use serde::Serialize;
 
 use super::{sorted_triangle, ClosedBoundary, CoreTets, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
-use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::bvh::TriangleBvh;
+use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::{triangle_area_vector, Aabb, DVec3};
 use crate::mesh::CellKind;
 use crate::quality::measures::{dihedral_range, edge_face_pairs};
 
 /// Quality of a flat or inverted tetrahedron: below every real angle.
 const INVALID: f64 = -1.0;
+
+/// Smallest rise of the worst angle (degrees) worth a change: below it, hill climbing crawls.
+const MIN_GAIN: f64 = 0.01;
 
 /// Largest ring of tetrahedra around an edge that edge removal rebuilds.
 const MAX_RING: usize = 7;
@@ -38,18 +41,30 @@ const TET_EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), 
 
 /// Smallest dihedral angle of tetrahedron `x` in degrees; [`INVALID`] when it is not positive.
 pub fn min_dihedral(x: [DVec3; 4]) -> f64 {
+    dihedral_extremes(x).map_or(INVALID, |(lo, _)| lo)
+}
+
+/// What the operators maximise: how far the dihedral angles of tetrahedron `x` stay from 0 and
+/// from 180 degrees (a cap, flat with an angle near 180, can have no small angle); [`INVALID`]
+/// when it is not positive.
+pub fn angle_quality(x: [DVec3; 4]) -> f64 {
+    dihedral_extremes(x).map_or(INVALID, |(lo, hi)| lo.min(180.0 - hi))
+}
+
+/// Smallest and largest dihedral angle of a positive tetrahedron, degrees.
+fn dihedral_extremes(x: [DVec3; 4]) -> Option<(f64, f64)> {
     if orient3d(x[0], x[1], x[2], x[3]) != Sign::Positive {
-        return INVALID;
+        return None;
     }
     let mut corners = [DVec3::ZERO; 8];
     corners[..4].copy_from_slice(&x);
-    dihedral_range(CellKind::Tetrahedron, &corners, &TET_EDGE_FACES).0
+    Some(dihedral_range(CellKind::Tetrahedron, &corners, &TET_EDGE_FACES))
 }
 
 /// How hard the improvement tries.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ImproveOptions {
-    /// Tetrahedra whose smallest dihedral angle (degrees) is below this are worked on.
+    /// Tetrahedra whose [`angle_quality`] (degrees) is below this are worked on.
     pub target_dihedral: f64,
     /// Passes over the bad tetrahedra (0: no improvement).
     pub passes: usize,
@@ -59,7 +74,7 @@ pub struct ImproveOptions {
 
 impl Default for ImproveOptions {
     fn default() -> Self {
-        ImproveOptions { target_dihedral: 15.0, passes: 6, insert_points: true }
+        ImproveOptions { target_dihedral: 12.0, passes: 20, insert_points: true }
     }
 }
 
@@ -91,7 +106,7 @@ pub struct Change {
 
 impl Change {
     fn improves(&self) -> bool {
-        self.after > self.before
+        self.after > self.before + MIN_GAIN
     }
 }
 
@@ -135,7 +150,7 @@ impl TetMesh {
     }
 
     fn quality(&self, tet: [u32; 4]) -> f64 {
-        min_dihedral(self.corners(tet))
+        angle_quality(self.corners(tet))
     }
 
     fn worst(&self, tets: impl IntoIterator<Item = [u32; 4]>) -> f64 {
@@ -300,7 +315,112 @@ impl TetMesh {
         let middle = 0.5 * (self.points[a as usize] + self.points[b as usize]);
         let (position, after) = self.best_position(&add, p, middle);
         let before = self.worst(tets.iter().map(|&t| self.tets[t as usize]));
-        Some(Change { remove: tets, add, point: Some((p, position)), before, after })
+        (after > INVALID).then(|| Change { remove: tets, add, point: Some((p, position)), before, after })
+    }
+
+    /// Insert a point at `p` (then moved where its tetrahedra are best): the tetrahedra whose
+    /// circumsphere holds `p`, grown from the one holding it (found by walking from `start`)
+    /// across interior faces, are replaced by the cone from the new point over their boundary
+    /// (Bowyer-Watson). `None` when `p` is outside the region or the cone is not positive.
+    pub fn insert_point(&self, start: u32, p: DVec3) -> Option<Change> {
+        let first = self.locate(start, p)?;
+        // The tetrahedron to improve goes too, whether or not its circumsphere holds `p`.
+        let mut cavity = vec![first];
+        if start != first && self.in_circumsphere(start, p) {
+            cavity.push(start);
+        }
+        let mut i = 0;
+        while let Some(&t) = cavity.get(i) {
+            i += 1;
+            for face in self.outward_faces(t) {
+                match self.neighbour(t, face) {
+                    Some(n) if !cavity.contains(&n) && cavity.len() < 64 && self.in_circumsphere(n, p) => {
+                        cavity.push(n)
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let v = self.points.len() as u32;
+        let mut add = Vec::new();
+        for &t in &cavity {
+            for face in self.outward_faces(t) {
+                if !self.neighbour(t, face).is_some_and(|n| cavity.contains(&n)) {
+                    add.push([face[0], face[2], face[1], v]);
+                }
+            }
+        }
+        let old: Vec<[u32; 4]> = cavity.iter().map(|&t| self.tets[t as usize]).collect();
+        let (position, after) = self.best_position(&add, v, p);
+        let new_volume: f64 = add.iter().map(|t| self.volume_at(*t, v, position)).sum();
+        let old_volume: f64 = old.iter().map(|t| self.volume_at(*t, v, position)).sum();
+        // A cavity that is not a ball (pinched) would not be filled exactly by the cone.
+        let fills = (new_volume - old_volume).abs() <= 1e-9 * old_volume;
+        let before = self.worst(old);
+        (after > INVALID && fills).then(|| Change {
+            remove: cavity,
+            add,
+            point: Some((v, position)),
+            before,
+            after,
+        })
+    }
+
+    fn volume_at(&self, tet: [u32; 4], v: u32, p: DVec3) -> f64 {
+        let [a, b, c, d] = tet.map(|u| if u == v { p } else { self.points[u as usize] });
+        crate::geometry::tet_signed_volume(a, b, c, d)
+    }
+
+    /// The faces of tetrahedron `t`, their right-hand normals pointing out of it.
+    fn outward_faces(&self, t: u32) -> [[u32; 3]; 4] {
+        let tet = self.tets[t as usize];
+        let faces = CellKind::Tetrahedron.faces();
+        std::array::from_fn(|k| [tet[faces[k][0]], tet[faces[k][1]], tet[faces[k][2]]])
+    }
+
+    /// The other tetrahedron on a face of `t` (none on the boundary).
+    fn neighbour(&self, t: u32, face: [u32; 3]) -> Option<u32> {
+        self.tets_with(&face).into_iter().find(|&s| s != t)
+    }
+
+    /// The tetrahedron holding `p`, walking from `start` across the faces `p` lies beyond;
+    /// `None` when the walk leaves the region or goes on too long.
+    fn locate(&self, start: u32, p: DVec3) -> Option<u32> {
+        let mut t = start;
+        'walk: for _ in 0..1000 {
+            for face in self.outward_faces(t) {
+                let [a, b, c] = face.map(|v| self.points[v as usize]);
+                if orient3d(a, b, c, p) == Sign::Positive {
+                    t = self.neighbour(t, face)?;
+                    continue 'walk;
+                }
+            }
+            return Some(t);
+        }
+        None
+    }
+
+    /// Whether `p` is inside the circumsphere of tetrahedron `t` (floating point: it only
+    /// chooses the cavity, whose cone is then checked exactly).
+    fn in_circumsphere(&self, t: u32, p: DVec3) -> bool {
+        let x = self.corners(self.tets[t as usize]);
+        circumcentre(x).is_some_and(|centre| (p - centre).length_squared() < (x[0] - centre).length_squared())
+    }
+
+    /// Where to insert a point for tetrahedron `t`: the best apex over each of its boundary
+    /// faces, and its circumcentre.
+    fn insertion_points(&self, t: u32) -> Vec<DVec3> {
+        let mut points: Vec<DVec3> = self
+            .outward_faces(t)
+            .into_iter()
+            .filter(|&face| self.neighbour(t, face).is_none())
+            .map(|f| {
+                let [a, b, c] = f.map(|v| self.points[v as usize]);
+                best_apex(a, c, b).0
+            })
+            .collect();
+        points.extend(circumcentre(self.corners(self.tets[t as usize])));
+        points
     }
 
     /// Worst quality of `ball` (tetrahedra at `v`) with `v` at `p`.
@@ -309,7 +429,7 @@ impl TetMesh {
     }
 
     fn quality_at(&self, tet: [u32; 4], v: u32, p: DVec3) -> f64 {
-        min_dihedral(tet.map(|u| if u == v { p } else { self.points[u as usize] }))
+        angle_quality(tet.map(|u| if u == v { p } else { self.points[u as usize] }))
     }
 
     /// Hill climbing on the worst tetrahedron of `ball` from `start`: first the centroid of
@@ -368,13 +488,17 @@ impl TetMesh {
         (direction != DVec3::ZERO && direction.is_finite()).then_some(direction)
     }
 
-    /// Try the operators on tetrahedron `t` and apply the first kind that helps: the best
-    /// flip, else smoothing one of its points, else the best point insertion.
-    fn improve_tet(&mut self, t: u32, options: &ImproveOptions, stats: &mut ImproveStats) -> bool {
+    /// The change the operators propose for tetrahedron `t`: the best flip, else the best
+    /// smoothing of one of its points, else the best point insertion, if one helps.
+    fn improve_tet(&self, t: u32, options: &ImproveOptions, stats: &mut ImproveStats) -> Option<Change> {
         let tet = self.tets[t as usize];
-        let mut flips: Vec<Change> = TET_EDGES.iter().filter_map(|&(i, j)| self.remove_edge(tet[i], tet[j])).collect();
+        let mut flips: Vec<Change> =
+            TET_EDGES.iter().filter_map(|&(i, j)| self.remove_edge(tet[i], tet[j])).collect();
         flips.extend(
-            CellKind::Tetrahedron.faces().iter().filter_map(|f| self.flip_23([tet[f[0]], tet[f[1]], tet[f[2]]])),
+            CellKind::Tetrahedron
+                .faces()
+                .iter()
+                .filter_map(|f| self.flip_23([tet[f[0]], tet[f[1]], tet[f[2]]])),
         );
         if let Some(change) = best_improving(flips) {
             match (change.remove.len(), change.add.len()) {
@@ -383,34 +507,44 @@ impl TetMesh {
                 (4, 4) => stats.flips_44 += 1,
                 _ => stats.edge_removals += 1,
             }
-            self.apply(&change);
-            return true;
+            return Some(change);
         }
         let smoothing = tet.iter().filter_map(|&v| self.smooth_vertex(v)).collect();
         if let Some(change) = best_improving(smoothing) {
             stats.smoothed_points += 1;
-            self.apply(&change);
-            return true;
+            return Some(change);
         }
         if !options.insert_points {
-            return false;
+            return None;
         }
-        let insertions = TET_EDGES.iter().filter_map(|&(i, j)| self.split_edge(tet[i], tet[j])).collect();
-        if let Some(change) = best_improving(insertions) {
-            stats.inserted_points += 1;
-            self.apply(&change);
-            return true;
-        }
-        false
+        let mut insertions: Vec<Change> =
+            TET_EDGES.iter().filter_map(|&(i, j)| self.split_edge(tet[i], tet[j])).collect();
+        insertions.extend(self.insertion_points(t).into_iter().filter_map(|p| self.insert_point(t, p)));
+        // Nearer the tetrahedron, the cavity is smaller and more often star-shaped.
+        let centre = self.corners(tet).iter().sum::<DVec3>() / 4.0;
+        insertions.extend(
+            self.insertion_points(t).into_iter().filter_map(|p| self.insert_point(t, 0.5 * (p + centre))),
+        );
+        let change = best_improving(insertions)?;
+        stats.inserted_points += 1;
+        Some(change)
     }
 
     /// Passes over the tetrahedra below the target angle, worst first.
     pub fn improve(&mut self, options: &ImproveOptions) -> ImproveStats {
         let start = Instant::now();
         let mut stats = ImproveStats::default();
-        for _ in 0..options.passes {
+        // A tetrahedron no operator helped is tried again only once something changed at one
+        // of its nodes: `failed[t]` is the pass it failed in, `changed[v]` the last pass that
+        // changed the tetrahedra at point `v` or moved it.
+        let mut failed: Vec<Option<usize>> = vec![None; self.tets.len()];
+        let mut changed = vec![0usize; self.points.len()];
+        for pass in 1..=options.passes {
+            let stale = |t: usize, tet: &[u32; 4]| {
+                failed[t].is_some_and(|f| tet.iter().all(|&v| changed[v as usize] < f))
+            };
             let mut bad: Vec<(f64, u32)> = (0..self.tets.len())
-                .filter(|&t| self.alive[t])
+                .filter(|&t| self.alive[t] && !stale(t, &self.tets[t]))
                 .map(|t| (self.quality(self.tets[t]), t as u32))
                 .filter(|&(q, _)| q < options.target_dihedral)
                 .collect();
@@ -419,19 +553,42 @@ impl TetMesh {
             }
             stats.passes += 1;
             bad.sort_by(|x, y| x.0.total_cmp(&y.0));
-            let mut changed = 0;
             for (_, t) in bad {
-                if self.alive[t as usize] && self.improve_tet(t, options, &mut stats) {
-                    changed += 1;
+                if !self.alive[t as usize] {
+                    continue;
                 }
-            }
-            if changed == 0 {
-                break;
+                match self.improve_tet(t, options, &mut stats) {
+                    Some(change) => {
+                        let touched = change
+                            .remove
+                            .iter()
+                            .map(|&s| self.tets[s as usize])
+                            .chain(change.add.iter().copied());
+                        let nodes: Vec<u32> = touched.flatten().chain(change.point.map(|p| p.0)).collect();
+                        self.apply(&change);
+                        changed.resize(self.points.len(), 0);
+                        failed.resize(self.tets.len(), None);
+                        for v in nodes {
+                            changed[v as usize] = pass;
+                        }
+                    }
+                    None => failed[t as usize] = Some(pass),
+                }
             }
         }
         stats.seconds = start.elapsed().as_secs_f64();
         stats
     }
+}
+
+/// The centre of the sphere through the corners of a tetrahedron (none when it is flat).
+fn circumcentre([a, b, c, d]: [DVec3; 4]) -> Option<DVec3> {
+    let (u, v, w) = (b - a, c - a, d - a);
+    let denominator = 2.0 * u.dot(v.cross(w));
+    let centre =
+        (u.length_squared() * v.cross(w) + v.length_squared() * w.cross(u) + w.length_squared() * u.cross(v))
+            / denominator;
+    (denominator != 0.0 && centre.is_finite()).then_some(a + centre)
 }
 
 /// The change that raises the worst angle most, if any does.
@@ -446,7 +603,8 @@ fn ring_pair(tet: [u32; 4], a: u32, b: u32) -> (u32, u32) {
     let rest: Vec<usize> = (0..4).filter(|&i| tet[i] != a && tet[i] != b).collect();
     let (x, y) = (rest.first().copied().unwrap_or(0), rest.get(1).copied().unwrap_or(0));
     let order = [position(a), position(b), x, y];
-    let inversions = (0..4).flat_map(|i| (i + 1..4).map(move |j| (i, j))).filter(|&(i, j)| order[i] > order[j]).count();
+    let inversions =
+        (0..4).flat_map(|i| (i + 1..4).map(move |j| (i, j))).filter(|&(i, j)| order[i] > order[j]).count();
     if inversions % 2 == 0 {
         (tet[x], tet[y])
     } else {
@@ -550,15 +708,20 @@ fn dihedral_at(x: [DVec3; 4], i: usize, j: usize) -> f64 {
     off(rest[0]).dot(off(rest[1])).clamp(-1.0, 1.0).acos().to_degrees()
 }
 
-/// The best smallest dihedral angle of a tetrahedron on triangle `(a, b, c)` (apex on the side
-/// its right-hand normal points to).
+/// The best [`angle_quality`] of a tetrahedron on triangle `(a, b, c)` (apex on the side its
+/// right-hand normal points to): no tetrahedron on it has all its dihedral angles further from
+/// 0 and 180 degrees.
 pub fn best_apex_quality(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    best_apex(a, b, c).1
+}
+
+/// The apex of [`best_apex_quality`] and its quality.
+fn best_apex(a: DVec3, b: DVec3, c: DVec3) -> (DVec3, f64) {
     let normal = (b - a).cross(c - a).normalize_or_zero();
     let edge = ((b - a).length() + (c - b).length() + (a - c).length()) / 3.0;
     let apex = (a + b + c) / 3.0 + normal * edge * (2.0f64 / 3.0).sqrt();
     let single = TetMesh::new(vec![a, b, c, apex], vec![[0, 1, 2, 3]], 3);
-    let (_, q) = single.best_position(&[[0, 1, 2, 3]], 3, apex);
-    q
+    single.best_position(&[[0, 1, 2, 3]], 3, apex)
 }
 
 /// Which boundary triangles (marker bits) every boundary point is on.
@@ -760,7 +923,11 @@ pub const SLIVER_THRESHOLD: f64 = 10.0;
 
 /// Improve the mesher's tetrahedra (`core`, filling `boundary`, whose points come first and
 /// stay) and measure them before and after.
-pub fn improve_core(boundary: &ClosedBoundary, core: CoreTets, options: &ImproveOptions) -> (CoreTets, CoreQuality) {
+pub fn improve_core(
+    boundary: &ClosedBoundary,
+    core: CoreTets,
+    options: &ImproveOptions,
+) -> (CoreTets, CoreQuality) {
     let worst = |points: &[DVec3], tets: &[[u32; 4]]| {
         tets.iter().map(|t| min_dihedral(t.map(|v| points[v as usize]))).fold(f64::INFINITY, f64::min)
     };

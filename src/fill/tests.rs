@@ -80,7 +80,10 @@ fn a_wall_that_is_not_the_meshes_is_rejected() {
 #[test]
 fn cube_in_a_box_without_layers() {
     let wall = shapes::cuboid(DVec3::splat(1.0), 4);
-    let options = CoreOptions { farfield: Some(FarfieldSpec { factor: 4.0, ..Default::default() }), ..Default::default() };
+    let options = CoreOptions {
+        farfield: Some(FarfieldSpec { factor: 4.0, ..Default::default() }),
+        ..Default::default()
+    };
     let (mesh, stats) = fill_core(&bare_wall(&wall), &wall, &options).unwrap();
     let check = quality::check(&mesh);
     assert!(check.is_valid(), "{check}");
