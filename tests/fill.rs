@@ -123,6 +123,7 @@ fn fill_and_check(
 
 #[test]
 fn box_with_layers_and_fans() {
+    // See also improvement_raises_the_worst_angle_of_the_box.
     let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
     let layers = layered(&wall, &config(&wall, 20));
     let stats = fill_and_check("box", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
@@ -135,6 +136,46 @@ fn sphere_with_layers() {
     let layers = layered(&wall, &config(&wall, 20));
     let stats = fill_and_check("sphere", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
     assert_eq!(stats.pyramids, 0, "a smooth sphere has no fans, so no quads");
+    // The core quality bar of issue 5, reached by our improvement (TetGen alone: 6.6 degrees).
+    assert!(stats.min_dihedral >= 10.0, "sphere: core min dihedral {:.2}", stats.min_dihedral);
+    assert_eq!(stats.quality.slivers.count, 0);
+}
+
+/// The core quality bar on the box. Fails today: about 150 tetrahedra of 5.6 to 10 degrees stay
+/// on the pyramids over the long thin quads of the fans along the box's edges (their side
+/// triangles are 0.25 long and 0.016 wide and meet at 175 degrees).
+#[test]
+#[ignore = "about 150 core tetrahedra of 5.6-10 degrees on the fans' pyramids along the box edges"]
+fn box_core_has_no_dihedral_angle_below_10_degrees() {
+    let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
+    let layers = layered(&wall, &config(&wall, 20));
+    let stats = fill_and_check("box", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
+    assert!(stats.min_dihedral >= 10.0, "box: core min dihedral {:.2}", stats.min_dihedral);
+}
+
+/// The improvement keeps the boundary (checked inside the fill, and by `fill_and_check`: every
+/// top face on exactly one core cell), never lowers the worst angle and leaves fewer
+/// tetrahedra below 10 degrees than TetGen.
+#[test]
+fn improvement_raises_the_worst_angle_of_the_box() {
+    let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
+    let layers = layered(&wall, &config(&wall, 20));
+    let stats = fill_and_check("box", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
+    let q = &stats.quality;
+    assert!(
+        q.min_dihedral > q.mesher_min_dihedral + 1.0,
+        "{} vs TetGen's {}",
+        q.min_dihedral,
+        q.mesher_min_dihedral
+    );
+    let below_10 = |h: &blmesh::fill::improve::DihedralHistogram| h.counts[0] + h.counts[1];
+    assert!(
+        below_10(&q.histogram) < below_10(&q.mesher_histogram),
+        "{} vs {}",
+        q.histogram,
+        q.mesher_histogram
+    );
+    assert_eq!(q.slivers.count, below_10(&q.histogram));
 }
 
 /// A patch without layers: its wall triangles are the core's boundary as they are, next to the
@@ -245,7 +286,8 @@ fn worst_core_tetrahedra() {
     let stats = mesh.improve(&ImproveOptions::default());
     eprintln!("{stats:?}");
     let q = |m: &TetMesh, t: [u32; 4]| angle_quality(t.map(|v| m.points[v as usize]));
-    let mut worst: Vec<[u32; 4]> = mesh.tets().filter(|&t| q(&mesh, t) < 10.0).collect();
+    let mut worst: Vec<[u32; 4]> =
+        mesh.tets().filter(|&t| q(&mesh, t) < 10.0 && t.iter().all(|&v| (v as usize) < fixed)).collect();
     worst.sort_by(|a, b| q(&mesh, *a).total_cmp(&q(&mesh, *b)));
     for t in worst.iter().take(6) {
         eprintln!("tet {t:?} q {:.2}", q(&mesh, *t));

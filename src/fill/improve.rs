@@ -30,6 +30,12 @@ const INVALID: f64 = -1.0;
 /// Smallest rise of the worst angle (degrees) worth a change: below it, hill climbing crawls.
 const MIN_GAIN: f64 = 0.01;
 
+/// A change may not leave more tetrahedra with an [`angle_quality`] below this (degrees).
+const COUNTED_BELOW: f64 = 12.0;
+
+/// A rise of the worst angle (degrees) worth two more tetrahedra below [`COUNTED_BELOW`].
+const MUCH_BETTER: f64 = 2.0;
+
 /// Largest ring of tetrahedra around an edge that edge removal rebuilds.
 const MAX_RING: usize = 7;
 
@@ -99,14 +105,46 @@ pub struct Change {
     pub remove: Vec<u32>,
     pub add: Vec<[u32; 4]>,
     pub point: Option<(u32, DVec3)>,
-    /// Smallest dihedral angle of the tetrahedra changed, before and after.
+    /// Worst [`angle_quality`] of the tetrahedra changed, before and after.
     pub before: f64,
     pub after: f64,
+    /// How many of them are below the target, before and after.
+    below_before: usize,
+    below_after: usize,
 }
 
 impl Change {
-    fn improves(&self) -> bool {
-        self.after > self.before + MIN_GAIN
+    fn from_qualities(
+        remove: Vec<u32>,
+        add: Vec<[u32; 4]>,
+        point: Option<(u32, DVec3)>,
+        old: &[f64],
+        new: &[f64],
+    ) -> Change {
+        let worst = |q: &[f64]| q.iter().copied().fold(f64::INFINITY, f64::min);
+        let below = |q: &[f64]| q.iter().filter(|&&x| x < COUNTED_BELOW).count();
+        Change {
+            remove,
+            add,
+            point,
+            before: worst(old),
+            after: worst(new),
+            below_before: below(old),
+            below_after: below(new),
+        }
+    }
+
+    /// The worst tetrahedron gets better and no more are left below [`COUNTED_BELOW`] (else a
+    /// point insertion can trade one sliver for several slightly better ones), or it gets much
+    /// better for at most two more.
+    fn improves(&self, rule: Rule) -> bool {
+        if rule == Rule::WorstFirst {
+            return self.after > self.before + MIN_GAIN;
+        }
+        let fewer_bad = self.below_after <= self.below_before;
+        let much_better =
+            self.after >= self.before + MUCH_BETTER && self.below_after <= self.below_before + 2;
+        self.after > self.before + MIN_GAIN && (fewer_bad || much_better)
     }
 }
 
@@ -212,6 +250,18 @@ impl TetMesh {
         (at == start && ring.len() == pairs.len()).then_some((tets, ring))
     }
 
+    /// The change replacing tetrahedra `remove` by `add` (with the point moved or added as
+    /// said); `None` when a new tetrahedron is not positive.
+    fn change(&self, remove: Vec<u32>, add: Vec<[u32; 4]>, point: Option<(u32, DVec3)>) -> Option<Change> {
+        let old: Vec<f64> = remove.iter().map(|&t| self.quality(self.tets[t as usize])).collect();
+        let new: Vec<f64> = match point {
+            Some((v, p)) => add.iter().map(|&t| self.quality_at(t, v, p)).collect(),
+            None => add.iter().map(|&t| self.quality(t)).collect(),
+        };
+        let change = Change::from_qualities(remove, add, point, &old, &new);
+        (change.after > INVALID).then_some(change)
+    }
+
     /// Flip 2-3: replace the two tetrahedra on the interior face `abc` by three around the
     /// edge joining their apexes. `None` when the face is on the boundary or a new tetrahedron
     /// would not be positive.
@@ -227,9 +277,7 @@ impl TetMesh {
             Sign::Zero => return None,
         };
         let add: Vec<[u32; 4]> = (0..3).map(|i| [bottom, top, face[i], face[(i + 1) % 3]]).collect();
-        let after = self.worst(add.iter().copied());
-        let before = self.worst([self.tets[s as usize], self.tets[t as usize]]);
-        (after > INVALID).then(|| Change { remove: tets, add, point: None, before, after })
+        self.change(tets, add, None)
     }
 
     /// Edge removal: replace the ring of tetrahedra around the interior edge `ab` (3 to
@@ -242,9 +290,7 @@ impl TetMesh {
             return None;
         }
         let add = self.best_ring_triangulation(a, b, &ring)?;
-        let after = self.worst(add.iter().copied());
-        let before = self.worst(tets.iter().map(|&t| self.tets[t as usize]));
-        Some(Change { remove: tets, add, point: None, before, after })
+        self.change(tets, add, None)
     }
 
     /// The triangulation of the ring polygon that maximises the worst of the tetrahedra
@@ -295,10 +341,10 @@ impl TetMesh {
             return None;
         }
         let ball: Vec<[u32; 4]> = self.ball[v as usize].iter().map(|&t| self.tets[t as usize]).collect();
-        let start = self.points[v as usize];
-        let before = self.worst(ball.iter().copied());
-        let (p, after) = self.best_position(&ball, v, start);
-        Some(Change { remove: Vec::new(), add: Vec::new(), point: Some((v, p)), before, after })
+        let (p, _) = self.best_position(&ball, v, self.points[v as usize]);
+        let old: Vec<f64> = ball.iter().map(|&t| self.quality(t)).collect();
+        let new: Vec<f64> = ball.iter().map(|&t| self.quality_at(t, v, p)).collect();
+        Some(Change::from_qualities(Vec::new(), Vec::new(), Some((v, p)), &old, &new))
     }
 
     /// Insert a point on the interior edge `ab`, placed where the worst of its tetrahedra is
@@ -313,9 +359,8 @@ impl TetMesh {
             })
             .collect();
         let middle = 0.5 * (self.points[a as usize] + self.points[b as usize]);
-        let (position, after) = self.best_position(&add, p, middle);
-        let before = self.worst(tets.iter().map(|&t| self.tets[t as usize]));
-        (after > INVALID).then(|| Change { remove: tets, add, point: Some((p, position)), before, after })
+        let (position, _) = self.best_position(&add, p, middle);
+        self.change(tets, add, Some((p, position)))
     }
 
     /// Insert a point at `p` (then moved where its tetrahedra are best): the tetrahedra whose
@@ -350,20 +395,15 @@ impl TetMesh {
                 }
             }
         }
-        let old: Vec<[u32; 4]> = cavity.iter().map(|&t| self.tets[t as usize]).collect();
-        let (position, after) = self.best_position(&add, v, p);
+        let (position, _) = self.best_position(&add, v, p);
         let new_volume: f64 = add.iter().map(|t| self.volume_at(*t, v, position)).sum();
-        let old_volume: f64 = old.iter().map(|t| self.volume_at(*t, v, position)).sum();
+        let old_volume: f64 =
+            cavity.iter().map(|&t| self.volume_at(self.tets[t as usize], v, position)).sum();
         // A cavity that is not a ball (pinched) would not be filled exactly by the cone.
-        let fills = (new_volume - old_volume).abs() <= 1e-9 * old_volume;
-        let before = self.worst(old);
-        (after > INVALID && fills).then(|| Change {
-            remove: cavity,
-            add,
-            point: Some((v, position)),
-            before,
-            after,
-        })
+        if (new_volume - old_volume).abs() > 1e-9 * old_volume {
+            return None;
+        }
+        self.change(cavity, add, Some((v, position)))
     }
 
     fn volume_at(&self, tet: [u32; 4], v: u32, p: DVec3) -> f64 {
@@ -490,7 +530,13 @@ impl TetMesh {
 
     /// The change the operators propose for tetrahedron `t`: the best flip, else the best
     /// smoothing of one of its points, else the best point insertion, if one helps.
-    fn improve_tet(&self, t: u32, options: &ImproveOptions, stats: &mut ImproveStats) -> Option<Change> {
+    fn improve_tet(
+        &self,
+        t: u32,
+        options: &ImproveOptions,
+        rule: Rule,
+        stats: &mut ImproveStats,
+    ) -> Option<Change> {
         let tet = self.tets[t as usize];
         let mut flips: Vec<Change> =
             TET_EDGES.iter().filter_map(|&(i, j)| self.remove_edge(tet[i], tet[j])).collect();
@@ -500,7 +546,7 @@ impl TetMesh {
                 .iter()
                 .filter_map(|f| self.flip_23([tet[f[0]], tet[f[1]], tet[f[2]]])),
         );
-        if let Some(change) = best_improving(flips) {
+        if let Some(change) = best_improving(flips, rule) {
             match (change.remove.len(), change.add.len()) {
                 (2, 3) => stats.flips_23 += 1,
                 (3, 2) => stats.flips_32 += 1,
@@ -510,11 +556,12 @@ impl TetMesh {
             return Some(change);
         }
         let smoothing = tet.iter().filter_map(|&v| self.smooth_vertex(v)).collect();
-        if let Some(change) = best_improving(smoothing) {
+        if let Some(change) = best_improving(smoothing, rule) {
             stats.smoothed_points += 1;
             return Some(change);
         }
-        if !options.insert_points {
+        // Insertion under the worst-first rule trades one sliver for many slightly better ones.
+        if !options.insert_points || rule == Rule::WorstFirst {
             return None;
         }
         let mut insertions: Vec<Change> =
@@ -525,15 +572,25 @@ impl TetMesh {
         insertions.extend(
             self.insertion_points(t).into_iter().filter_map(|p| self.insert_point(t, 0.5 * (p + centre))),
         );
-        let change = best_improving(insertions)?;
+        let change = best_improving(insertions, rule)?;
         stats.inserted_points += 1;
         Some(change)
     }
 
     /// Passes over the tetrahedra below the target angle, worst first.
+    /// Passes over the tetrahedra below the target quality, worst first: first changes that
+    /// leave fewer bad tetrahedra, then, for those still below [`SLIVER_THRESHOLD`], any change
+    /// that raises the worst angle.
     pub fn improve(&mut self, options: &ImproveOptions) -> ImproveStats {
         let start = Instant::now();
         let mut stats = ImproveStats::default();
+        self.passes(options, Rule::FewerBad, options.target_dihedral, &mut stats);
+        self.passes(options, Rule::WorstFirst, options.target_dihedral.min(SLIVER_THRESHOLD), &mut stats);
+        stats.seconds = start.elapsed().as_secs_f64();
+        stats
+    }
+
+    fn passes(&mut self, options: &ImproveOptions, rule: Rule, target: f64, stats: &mut ImproveStats) {
         // A tetrahedron no operator helped is tried again only once something changed at one
         // of its nodes: `failed[t]` is the pass it failed in, `changed[v]` the last pass that
         // changed the tetrahedra at point `v` or moved it.
@@ -546,7 +603,7 @@ impl TetMesh {
             let mut bad: Vec<(f64, u32)> = (0..self.tets.len())
                 .filter(|&t| self.alive[t] && !stale(t, &self.tets[t]))
                 .map(|t| (self.quality(self.tets[t]), t as u32))
-                .filter(|&(q, _)| q < options.target_dihedral)
+                .filter(|&(q, _)| q < target)
                 .collect();
             if bad.is_empty() {
                 break;
@@ -557,7 +614,7 @@ impl TetMesh {
                 if !self.alive[t as usize] {
                     continue;
                 }
-                match self.improve_tet(t, options, &mut stats) {
+                match self.improve_tet(t, options, rule, stats) {
                     Some(change) => {
                         let touched = change
                             .remove
@@ -576,8 +633,6 @@ impl TetMesh {
                 }
             }
         }
-        stats.seconds = start.elapsed().as_secs_f64();
-        stats
     }
 }
 
@@ -591,9 +646,19 @@ fn circumcentre([a, b, c, d]: [DVec3; 4]) -> Option<DVec3> {
     (denominator != 0.0 && centre.is_finite()).then_some(a + centre)
 }
 
-/// The change that raises the worst angle most, if any does.
-fn best_improving(changes: Vec<Change>) -> Option<Change> {
-    changes.into_iter().filter(Change::improves).max_by(|x, y| x.after.total_cmp(&y.after))
+/// The change that raises the worst angle most, if any does by the rule.
+fn best_improving(changes: Vec<Change>, rule: Rule) -> Option<Change> {
+    changes.into_iter().filter(|c| c.improves(rule)).max_by(|x, y| x.after.total_cmp(&y.after))
+}
+
+/// When a change is an improvement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Rule {
+    /// The worst angle rises and no more tetrahedra are left below [`COUNTED_BELOW`] (or only
+    /// two more, for a much better worst angle).
+    FewerBad,
+    /// The worst angle rises.
+    WorstFirst,
 }
 
 /// The other two nodes `(x, y)` of `tet` (positive, with nodes `a` and `b`) ordered so that
