@@ -36,6 +36,9 @@ const COUNTED_BELOW: f64 = 12.0;
 /// A rise of the worst angle (degrees) worth two more tetrahedra below [`COUNTED_BELOW`].
 const MUCH_BETTER: f64 = 2.0;
 
+/// Passes of the worst-first rule at most (they cost more than they give after a few).
+const WORST_FIRST_PASSES: usize = 3;
+
 /// Largest ring of tetrahedra around an edge that edge removal rebuilds.
 const MAX_RING: usize = 7;
 
@@ -584,19 +587,33 @@ impl TetMesh {
     pub fn improve(&mut self, options: &ImproveOptions) -> ImproveStats {
         let start = Instant::now();
         let mut stats = ImproveStats::default();
-        self.passes(options, Rule::FewerBad, options.target_dihedral, &mut stats);
-        self.passes(options, Rule::WorstFirst, options.target_dihedral.min(SLIVER_THRESHOLD), &mut stats);
+        self.passes(options.passes, options, Rule::FewerBad, options.target_dihedral, &mut stats);
+        let worst_first = options.passes.min(WORST_FIRST_PASSES);
+        self.passes(
+            worst_first,
+            options,
+            Rule::WorstFirst,
+            options.target_dihedral.min(SLIVER_THRESHOLD),
+            &mut stats,
+        );
         stats.seconds = start.elapsed().as_secs_f64();
         stats
     }
 
-    fn passes(&mut self, options: &ImproveOptions, rule: Rule, target: f64, stats: &mut ImproveStats) {
+    fn passes(
+        &mut self,
+        passes: usize,
+        options: &ImproveOptions,
+        rule: Rule,
+        target: f64,
+        stats: &mut ImproveStats,
+    ) {
         // A tetrahedron no operator helped is tried again only once something changed at one
         // of its nodes: `failed[t]` is the pass it failed in, `changed[v]` the last pass that
         // changed the tetrahedra at point `v` or moved it.
         let mut failed: Vec<Option<usize>> = vec![None; self.tets.len()];
         let mut changed = vec![0usize; self.points.len()];
-        for pass in 1..=options.passes {
+        for pass in 1..=passes {
             let stale = |t: usize, tet: &[u32; 4]| {
                 failed[t].is_some_and(|f| tet.iter().all(|&v| changed[v as usize] < f))
             };
@@ -758,6 +775,9 @@ pub struct SliverCensus {
     pub boundary_triangle: usize,
     pub thin_gap: usize,
     pub not_forced: usize,
+    /// Of all of them, those with their four nodes on the boundary (no point to move: only a
+    /// point inserted near them can remove them).
+    pub all_nodes_on_boundary: usize,
     /// The worst few.
     pub examples: Vec<Sliver>,
 }
@@ -830,6 +850,8 @@ impl SliverCensus {
                 .iter()
                 .filter_map(|&(i, j)| edge_angle.get(&sorted_edge(tet[i], tet[j])))
                 .fold(f64::INFINITY, |a, &b| a.min(b));
+            let interior_nodes = tet.iter().filter(|&&v| v as usize >= boundary.points.len()).count();
+            census.all_nodes_on_boundary += usize::from(interior_nodes == 0);
             let centre = x.iter().sum::<DVec3>() / 4.0;
             let (gap_width, nearest_inradius) = gap_across_nearest(&bvh, centre);
             let cause = if boundary_edge_angle < threshold {
@@ -860,7 +882,7 @@ impl SliverCensus {
                     front_nodes: count(MARKER_FRONT),
                     wall_nodes: count(MARKER_WALL),
                     farfield_nodes: count(MARKER_FARFIELD),
-                    interior_nodes: tet.iter().filter(|&&v| v as usize >= boundary.points.len()).count(),
+                    interior_nodes,
                 });
             }
         }
