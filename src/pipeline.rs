@@ -291,12 +291,30 @@ impl std::fmt::Display for MeshReport {
             self.normals.corner_patches
         )?;
         match &self.core {
-            Some(c) => writeln!(
-                f,
-                "core      {} tetrahedra ({} pyramids on front quads), dihedral {:.1}..{:.1} deg, {} boundary points added",
-                c.tetrahedra, c.pyramids, c.min_dihedral, c.max_dihedral, c.boundary_steiner_points
-            )?,
-            None => writeln!(f, "core      not built (--no-core): the layers' top faces are the patch bl_top")?,
+            Some(c) => {
+                let q = &c.quality;
+                let s = &q.slivers;
+                let i = &q.improvement;
+                writeln!(
+                    f,
+                    "core      {} tetrahedra ({} pyramids on front quads), dihedral {:.1}..{:.1} deg (TetGen's min {:.1}), {} boundary points added",
+                    c.tetrahedra, c.pyramids, c.min_dihedral, c.max_dihedral, q.mesher_min_dihedral, c.boundary_steiner_points
+                )?;
+                writeln!(
+                    f,
+                    "          improvement: {} flips 2-3, {} 3-2, {} 4-4, {} larger edge removals, {} points smoothed, {} inserted ({:.2} s)",
+                    i.flips_23, i.flips_32, i.flips_44, i.edge_removals, i.smoothed_points, i.inserted_points, i.seconds
+                )?;
+                writeln!(
+                    f,
+                    "          {} tetrahedra below {:.0} deg: {} at a thin angle of the boundary, {} on a badly shaped boundary triangle, {} in a thin gap, {} not forced by the boundary ({} with all nodes on the boundary)",
+                    s.count, s.threshold, s.boundary_angle, s.boundary_triangle, s.thin_gap, s.not_forced, s.all_nodes_on_boundary
+                )?;
+                writeln!(f, "          min dihedral per tetrahedron (deg): {}", q.histogram)?;
+            }
+            None => {
+                writeln!(f, "core      not built (--no-core): the layers' top faces are the patch bl_top")?
+            }
         }
         writeln!(f, "quality   worst scaled Jacobian {:.3}", worst_scaled_jacobian(&self.check))?;
         for w in &self.warnings {

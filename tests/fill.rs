@@ -113,11 +113,17 @@ fn fill_and_check(
         stats.seconds,
         stats.mesher_seconds
     );
+    let q = &stats.quality;
+    eprintln!(
+        "{name}: TetGen min dihedral {:.2}, after improvement {:.2} ({:?}); histogram {}; below 10: {:?}",
+        q.mesher_min_dihedral, q.min_dihedral, q.improvement, q.histogram, q.slivers
+    );
     stats
 }
 
 #[test]
 fn box_with_layers_and_fans() {
+    // See also improvement_raises_the_worst_angle_of_the_box.
     let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
     let layers = layered(&wall, &config(&wall, 20));
     let stats = fill_and_check("box", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
@@ -130,6 +136,46 @@ fn sphere_with_layers() {
     let layers = layered(&wall, &config(&wall, 20));
     let stats = fill_and_check("sphere", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
     assert_eq!(stats.pyramids, 0, "a smooth sphere has no fans, so no quads");
+    // The core quality bar of issue 5, reached by our improvement (TetGen alone: 6.6 degrees).
+    assert!(stats.min_dihedral >= 10.0, "sphere: core min dihedral {:.2}", stats.min_dihedral);
+    assert_eq!(stats.quality.slivers.count, 0);
+}
+
+/// The core quality bar on the box. Fails today: about 150 tetrahedra of 5.6 to 10 degrees stay
+/// on the pyramids over the long thin quads of the fans along the box's edges (their side
+/// triangles are 0.25 long and 0.016 wide and meet at 175 degrees).
+#[test]
+#[ignore = "about 150 core tetrahedra of 5.6-10 degrees on the fans' pyramids along the box edges"]
+fn box_core_has_no_dihedral_angle_below_10_degrees() {
+    let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
+    let layers = layered(&wall, &config(&wall, 20));
+    let stats = fill_and_check("box", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
+    assert!(stats.min_dihedral >= 10.0, "box: core min dihedral {:.2}", stats.min_dihedral);
+}
+
+/// The improvement keeps the boundary (checked inside the fill, and by `fill_and_check`: every
+/// top face on exactly one core cell), never lowers the worst angle and leaves fewer
+/// tetrahedra below 10 degrees than TetGen.
+#[test]
+fn improvement_raises_the_worst_angle_of_the_box() {
+    let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
+    let layers = layered(&wall, &config(&wall, 20));
+    let stats = fill_and_check("box", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
+    let q = &stats.quality;
+    assert!(
+        q.min_dihedral > q.mesher_min_dihedral + 1.0,
+        "{} vs TetGen's {}",
+        q.min_dihedral,
+        q.mesher_min_dihedral
+    );
+    let below_10 = |h: &blmesh::fill::improve::DihedralHistogram| h.counts[0] + h.counts[1];
+    assert!(
+        below_10(&q.histogram) < below_10(&q.mesher_histogram),
+        "{} vs {}",
+        q.histogram,
+        q.mesher_histogram
+    );
+    assert_eq!(q.slivers.count, below_10(&q.histogram));
 }
 
 /// A patch without layers: its wall triangles are the core's boundary as they are, next to the
@@ -200,5 +246,70 @@ fn spot_with_20_layers_fills_or_reports_the_crossing_front() {
         }
         Err(e @ FillError::SelfIntersecting { .. }) => eprintln!("spot, 20 layers: {e}"),
         Err(e) => panic!("spot, 20 layers: {e}"),
+    }
+}
+
+/// Diagnostic (run by hand): the worst tetrahedra left after the improvement on a surface
+/// (`BLMESH_SURFACE`, default spot), with what each operator could do on them.
+#[test]
+#[ignore = "diagnostic"]
+fn worst_core_tetrahedra() {
+    use blmesh::fill::improve::{angle_quality, ImproveOptions, TetMesh};
+    use blmesh::fill::{fill_core_with, tetgen::TetGen, ClosedBoundary, CoreMesher, CoreTets, PointSizing};
+    use std::cell::RefCell;
+    struct Capture(RefCell<Option<(ClosedBoundary, CoreTets)>>);
+    impl CoreMesher for Capture {
+        fn fill(&self, b: &ClosedBoundary, s: &PointSizing) -> Result<CoreTets, FillError> {
+            let t = TetGen::default().fill(b, s)?;
+            *self.0.borrow_mut() = Some((b.clone(), t.clone()));
+            Ok(t)
+        }
+    }
+    let name = std::env::var("BLMESH_SURFACE").unwrap_or_else(|_| "spot.obj".into());
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/geometries").join(&name);
+    let (wall, cfg) = match name.as_str() {
+        "box" => {
+            let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
+            let cfg = config(&wall, 20);
+            (wall, cfg)
+        }
+        _ => (blmesh::io::read_surface(&path).unwrap(), Config::default()),
+    };
+    let layers = layered(&wall, &cfg);
+    let capture = Capture(RefCell::new(None));
+    let options =
+        CoreOptions { improve: ImproveOptions { passes: 0, ..Default::default() }, ..Default::default() };
+    fill_core_with(&capture, &layers, &wall, &options).unwrap();
+    let (boundary, core) = capture.0.into_inner().unwrap();
+    let fixed = boundary.points.len();
+    let mut mesh = TetMesh::new(core.points, core.tets, fixed);
+    let stats = mesh.improve(&ImproveOptions::default());
+    eprintln!("{stats:?}");
+    let q = |m: &TetMesh, t: [u32; 4]| angle_quality(t.map(|v| m.points[v as usize]));
+    let mut worst: Vec<[u32; 4]> =
+        mesh.tets().filter(|&t| q(&mesh, t) < 10.0 && t.iter().all(|&v| (v as usize) < fixed)).collect();
+    worst.sort_by(|a, b| q(&mesh, *a).total_cmp(&q(&mesh, *b)));
+    for t in worst.iter().take(6) {
+        eprintln!("tet {t:?} q {:.2}", q(&mesh, *t));
+        for v in t {
+            let ball: Vec<f64> = mesh.tets().filter(|s| s.contains(v)).map(|s| q(&mesh, s)).collect();
+            let mut ball = ball;
+            ball.sort_by(f64::total_cmp);
+            eprintln!(
+                "  node {v} fixed {} at {:?} ball worst {:?}",
+                (*v as usize) < fixed,
+                mesh.points[*v as usize],
+                &ball[..ball.len().min(4)]
+            );
+        }
+        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+            let ring = mesh.ring(t[i], t[j]).map(|r| r.1.len());
+            let rem = mesh.remove_edge(t[i], t[j]).map(|c| (c.before, c.after));
+            let split = mesh.split_edge(t[i], t[j]).map(|c| (c.before, c.after));
+            eprintln!("  edge {i}{j}: ring {ring:?} removal {rem:?} split {split:?}");
+        }
+        for v in t {
+            eprintln!("  smooth {v}: {:?}", mesh.smooth_vertex(*v).map(|c| (c.before, c.after)));
+        }
     }
 }

@@ -9,6 +9,7 @@
 
 pub mod farfield;
 mod front;
+pub mod improve;
 mod merge;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;
@@ -259,12 +260,14 @@ impl Default for FarfieldSpec {
 pub struct CoreOptions {
     /// The outer boundary; `None` for internal flow (the front alone bounds the core).
     pub farfield: Option<FarfieldSpec>,
+    /// Our improvement of the mesher's tetrahedra ([`improve`]).
+    pub improve: improve::ImproveOptions,
 }
 
 impl Default for CoreOptions {
     /// External flow in the default box farfield.
     fn default() -> Self {
-        CoreOptions { farfield: Some(FarfieldSpec::default()) }
+        CoreOptions { farfield: Some(FarfieldSpec::default()), improve: Default::default() }
     }
 }
 
@@ -275,7 +278,7 @@ impl CoreOptions {
             Flow::External => Some(FarfieldSpec { shape: config.farfield, ..Default::default() }),
             Flow::Internal => None,
         };
-        CoreOptions { farfield }
+        CoreOptions { farfield, improve: Default::default() }
     }
 }
 
@@ -292,6 +295,8 @@ pub struct CoreStats {
     /// Smallest and largest dihedral angle of the core tetrahedra, degrees.
     pub min_dihedral: f64,
     pub max_dihedral: f64,
+    /// The dihedral angles before and after our improvement, and what is left below 10 degrees.
+    pub quality: improve::CoreQuality,
     /// Wall-clock time of the whole fill and of the mesher alone, seconds.
     pub seconds: f64,
     pub mesher_seconds: f64,
@@ -336,7 +341,10 @@ pub fn fill_core_with(
     let tets = mesher.fill(&boundary, &sizing)?;
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     merge::check_boundary_kept(&boundary, &tets)?;
+    let (tets, quality) = improve::improve_core(&boundary, tets, &options.improve);
+    merge::check_boundary_kept(&boundary, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
+    stats.quality = quality;
     stats.boundary_steiner_points = tets.boundary_steiner_points;
     stats.mesher_seconds = mesher_seconds;
     stats.seconds = start.elapsed().as_secs_f64();

@@ -80,7 +80,10 @@ fn a_wall_that_is_not_the_meshes_is_rejected() {
 #[test]
 fn cube_in_a_box_without_layers() {
     let wall = shapes::cuboid(DVec3::splat(1.0), 4);
-    let options = CoreOptions { farfield: Some(FarfieldSpec { factor: 4.0, ..Default::default() }) };
+    let options = CoreOptions {
+        farfield: Some(FarfieldSpec { factor: 4.0, ..Default::default() }),
+        ..Default::default()
+    };
     let (mesh, stats) = fill_core(&bare_wall(&wall), &wall, &options).unwrap();
     let check = quality::check(&mesh);
     assert!(check.is_valid(), "{check}");
@@ -142,7 +145,7 @@ mod properties {
             let wall = shapes::cuboid(DVec3::new(size.0, size.1, size.2), n);
             let shape = if sphere { crate::config::FarfieldShape::Sphere } else { crate::config::FarfieldShape::Box };
             let spec = FarfieldSpec { shape, factor, cell_size: None };
-            let options = CoreOptions { farfield: Some(spec) };
+            let options = CoreOptions { farfield: Some(spec), ..Default::default() };
             let (mesh, stats) = fill_core(&bare_wall(&wall), &wall, &options).unwrap();
             let check = quality::check(&mesh);
             prop_assert!(check.is_valid(), "{}", check);

@@ -11,7 +11,8 @@
 //! - `m`: the size at every boundary point (`pointmtrlist`): a tetrahedron is split while its
 //!   circumradius exceeds the size at one of its nodes; added points interpolate the sizes;
 //! - `O{level}/7`: mesh optimisation after refinement (flips, smoothing of added points, point
-//!   insertion/deletion), `level` passes.
+//!   insertion/deletion), `level` passes;
+//! - `o/{angle}`: the optimisation works on tetrahedra with a dihedral angle above `angle`.
 //!
 //! Hole points (`holelist`) inside the body shells make TetGen carve the body's interior.
 //! TetGen keeps global state, so calls are serialised.
@@ -36,11 +37,15 @@ pub struct TetGen {
     pub min_dihedral: f64,
     /// Optimisation passes (`-O`), 0..=9.
     pub optimisation: u8,
+    /// The optimisation works on tetrahedra with a dihedral angle above this, degrees
+    /// (`-o/angle`; TetGen's default 165). 150 halves the tetrahedra below 10 degrees that
+    /// TetGen leaves on spot and the Onera M6, at no cost in time.
+    pub optimisation_max_dihedral: f64,
 }
 
 impl Default for TetGen {
     fn default() -> Self {
-        TetGen { radius_edge: 1.4, min_dihedral: 18.0, optimisation: 9 }
+        TetGen { radius_edge: 1.4, min_dihedral: 18.0, optimisation: 9, optimisation_max_dihedral: 150.0 }
     }
 }
 
@@ -50,7 +55,8 @@ impl TetGen {
         let radius_edge = self.radius_edge.max(1.0);
         let angle = self.min_dihedral.clamp(0.0, 60.0);
         let level = self.optimisation.min(9);
-        format!("pYMzQq{radius_edge:.4}/{angle:.4}O{level}/7{}", if sized { "m" } else { "" })
+        let max_angle = self.optimisation_max_dihedral.clamp(90.0, 180.0);
+        format!("pYMzQq{radius_edge:.4}/{angle:.4}O{level}/7o/{max_angle:.4}{}", if sized { "m" } else { "" })
     }
 }
 

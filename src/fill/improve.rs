@@ -1,0 +1,1039 @@
+//! Improvement of the core tetrahedra after the mesher, with small local operators in the manner
+//! of MMG and of Klingner & Shewchuk ("Aggressive tetrahedral mesh improvement", 2007): face
+//! flips ([`TetMesh::flip_23`]), edge removal ([`TetMesh::remove_edge`]: 3-2, 4-4 and larger
+//! rings), smoothing of the points the mesher added ([`TetMesh::smooth_vertex`]) and insertion of
+//! points on interior edges ([`TetMesh::split_edge`]).
+//!
+//! The boundary never changes: an operator removes only faces with a tetrahedron on both sides
+//! and edges with a closed ring of tetrahedra around them (so every boundary triangle stays a
+//! face of the cavity it rebuilds), moves only points above the fixed boundary points, and adds
+//! points only inside. Every tetrahedron it creates is positive by the exact `orient3d`. The
+//! quality is the smallest dihedral angle; an operator is applied only when it raises the
+//! smallest angle of the tetrahedra it replaces.
+
+use std::collections::{HashMap, HashSet};
+use std::sync::LazyLock;
+use std::time::Instant;
+
+use serde::Serialize;
+
+use super::{sorted_triangle, ClosedBoundary, CoreTets, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
+use crate::geometry::bvh::TriangleBvh;
+use crate::geometry::predicates::{orient3d, Sign};
+use crate::geometry::{triangle_area_vector, Aabb, DVec3};
+use crate::mesh::CellKind;
+use crate::quality::measures::{dihedral_range, edge_face_pairs};
+
+/// Quality of a flat or inverted tetrahedron: below every real angle.
+const INVALID: f64 = -1.0;
+
+/// Smallest rise of the worst angle (degrees) worth a change: below it, hill climbing crawls.
+const MIN_GAIN: f64 = 0.01;
+
+/// A change may not leave more tetrahedra with an [`angle_quality`] below this (degrees).
+const COUNTED_BELOW: f64 = 12.0;
+
+/// A rise of the worst angle (degrees) worth two more tetrahedra below [`COUNTED_BELOW`].
+const MUCH_BETTER: f64 = 2.0;
+
+/// Passes of the worst-first rule at most (they cost more than they give after a few).
+const WORST_FIRST_PASSES: usize = 3;
+
+/// Largest ring of tetrahedra around an edge that edge removal rebuilds.
+const MAX_RING: usize = 7;
+
+static TET_EDGE_FACES: LazyLock<Vec<(usize, usize)>> =
+    LazyLock::new(|| edge_face_pairs(CellKind::Tetrahedron));
+
+/// The six edges of a tetrahedron, as local node pairs.
+const TET_EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+
+/// Smallest dihedral angle of tetrahedron `x` in degrees; [`INVALID`] when it is not positive.
+pub fn min_dihedral(x: [DVec3; 4]) -> f64 {
+    dihedral_extremes(x).map_or(INVALID, |(lo, _)| lo)
+}
+
+/// What the operators maximise: how far the dihedral angles of tetrahedron `x` stay from 0 and
+/// from 180 degrees (a cap, flat with an angle near 180, can have no small angle); [`INVALID`]
+/// when it is not positive.
+pub fn angle_quality(x: [DVec3; 4]) -> f64 {
+    dihedral_extremes(x).map_or(INVALID, |(lo, hi)| lo.min(180.0 - hi))
+}
+
+/// Smallest and largest dihedral angle of a positive tetrahedron, degrees.
+fn dihedral_extremes(x: [DVec3; 4]) -> Option<(f64, f64)> {
+    if orient3d(x[0], x[1], x[2], x[3]) != Sign::Positive {
+        return None;
+    }
+    let mut corners = [DVec3::ZERO; 8];
+    corners[..4].copy_from_slice(&x);
+    Some(dihedral_range(CellKind::Tetrahedron, &corners, &TET_EDGE_FACES))
+}
+
+/// How hard the improvement tries.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ImproveOptions {
+    /// Tetrahedra whose [`angle_quality`] (degrees) is below this are worked on.
+    pub target_dihedral: f64,
+    /// Passes over the bad tetrahedra (0: no improvement).
+    pub passes: usize,
+    /// Insert points on interior edges when flips and smoothing do not help.
+    pub insert_points: bool,
+}
+
+impl Default for ImproveOptions {
+    fn default() -> Self {
+        ImproveOptions { target_dihedral: 12.0, passes: 20, insert_points: true }
+    }
+}
+
+/// What the improvement did.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct ImproveStats {
+    pub flips_23: usize,
+    pub flips_32: usize,
+    pub flips_44: usize,
+    /// Edge removals with rings of 5 to [`MAX_RING`] tetrahedra.
+    pub edge_removals: usize,
+    pub smoothed_points: usize,
+    pub inserted_points: usize,
+    pub passes: usize,
+    pub seconds: f64,
+}
+
+/// A local change proposed by an operator: tetrahedra to remove and to add, and a point moved
+/// (or added, when its index is the point count).
+#[derive(Clone, Debug)]
+pub struct Change {
+    pub remove: Vec<u32>,
+    pub add: Vec<[u32; 4]>,
+    pub point: Option<(u32, DVec3)>,
+    /// Worst [`angle_quality`] of the tetrahedra changed, before and after.
+    pub before: f64,
+    pub after: f64,
+    /// How many of them are below the target, before and after.
+    below_before: usize,
+    below_after: usize,
+}
+
+impl Change {
+    fn from_qualities(
+        remove: Vec<u32>,
+        add: Vec<[u32; 4]>,
+        point: Option<(u32, DVec3)>,
+        old: &[f64],
+        new: &[f64],
+    ) -> Change {
+        let worst = |q: &[f64]| q.iter().copied().fold(f64::INFINITY, f64::min);
+        let below = |q: &[f64]| q.iter().filter(|&&x| x < COUNTED_BELOW).count();
+        Change {
+            remove,
+            add,
+            point,
+            before: worst(old),
+            after: worst(new),
+            below_before: below(old),
+            below_after: below(new),
+        }
+    }
+
+    /// The worst tetrahedron gets better and no more are left below [`COUNTED_BELOW`] (else a
+    /// point insertion can trade one sliver for several slightly better ones), or it gets much
+    /// better for at most two more.
+    fn improves(&self, rule: Rule) -> bool {
+        if rule == Rule::WorstFirst {
+            return self.after > self.before + MIN_GAIN;
+        }
+        let fewer_bad = self.below_after <= self.below_before;
+        let much_better =
+            self.after >= self.before + MUCH_BETTER && self.below_after <= self.below_before + 2;
+        self.after > self.before + MIN_GAIN && (fewer_bad || much_better)
+    }
+}
+
+/// A tetrahedral mesh with the tetrahedra at every point, for local changes.
+#[derive(Clone, Debug)]
+pub struct TetMesh {
+    pub points: Vec<DVec3>,
+    tets: Vec<[u32; 4]>,
+    alive: Vec<bool>,
+    /// The live tetrahedra at every point.
+    ball: Vec<Vec<u32>>,
+    /// Points below this index are on the boundary: they never move.
+    fixed: usize,
+}
+
+impl TetMesh {
+    /// `tets` must be positive and index `points`; the first `fixed` points never move.
+    pub fn new(points: Vec<DVec3>, tets: Vec<[u32; 4]>, fixed: usize) -> TetMesh {
+        let mut ball = vec![Vec::new(); points.len()];
+        for (t, tet) in tets.iter().enumerate() {
+            for &v in tet {
+                ball[v as usize].push(t as u32);
+            }
+        }
+        let alive = vec![true; tets.len()];
+        TetMesh { points, tets, alive, ball, fixed }
+    }
+
+    /// The live tetrahedra.
+    pub fn tets(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
+        self.tets.iter().zip(&self.alive).filter(|(_, &a)| a).map(|(t, _)| *t)
+    }
+
+    pub fn into_parts(self) -> (Vec<DVec3>, Vec<[u32; 4]>) {
+        let tets = self.tets().collect();
+        (self.points, tets)
+    }
+
+    fn corners(&self, tet: [u32; 4]) -> [DVec3; 4] {
+        tet.map(|v| self.points[v as usize])
+    }
+
+    fn quality(&self, tet: [u32; 4]) -> f64 {
+        angle_quality(self.corners(tet))
+    }
+
+    fn worst(&self, tets: impl IntoIterator<Item = [u32; 4]>) -> f64 {
+        tets.into_iter().map(|t| self.quality(t)).fold(f64::INFINITY, f64::min)
+    }
+
+    /// Commit a change proposed by one of the operators.
+    pub fn apply(&mut self, change: &Change) {
+        if let Some((v, p)) = change.point {
+            if v as usize == self.points.len() {
+                self.points.push(p);
+                self.ball.push(Vec::new());
+            } else {
+                self.points[v as usize] = p;
+            }
+        }
+        for &t in &change.remove {
+            self.alive[t as usize] = false;
+            for v in self.tets[t as usize] {
+                self.ball[v as usize].retain(|&s| s != t);
+            }
+        }
+        for &tet in &change.add {
+            let t = self.tets.len() as u32;
+            self.tets.push(tet);
+            self.alive.push(true);
+            for v in tet {
+                self.ball[v as usize].push(t);
+            }
+        }
+    }
+
+    /// The live tetrahedra having all of `nodes`.
+    fn tets_with(&self, nodes: &[u32]) -> Vec<u32> {
+        let Some(&first) = nodes.first() else { return Vec::new() };
+        self.ball[first as usize]
+            .iter()
+            .copied()
+            .filter(|&t| nodes.iter().all(|v| self.tets[t as usize].contains(v)))
+            .collect()
+    }
+
+    /// The tetrahedra around edge `ab` and their other nodes in order, when they close a ring
+    /// (the edge is interior): consecutive ring nodes `x, y` make the positive tetrahedron
+    /// `(a, b, x, y)`.
+    pub fn ring(&self, a: u32, b: u32) -> Option<(Vec<u32>, Vec<u32>)> {
+        let tets = self.tets_with(&[a, b]);
+        let pairs: Vec<(u32, u32)> = tets.iter().map(|&t| ring_pair(self.tets[t as usize], a, b)).collect();
+        let start = pairs.first()?.0;
+        let mut ring = vec![start];
+        let mut at = start;
+        for _ in 0..pairs.len() {
+            at = pairs.iter().find(|p| p.0 == at)?.1;
+            if at == start {
+                break;
+            }
+            ring.push(at);
+        }
+        (at == start && ring.len() == pairs.len()).then_some((tets, ring))
+    }
+
+    /// The change replacing tetrahedra `remove` by `add` (with the point moved or added as
+    /// said); `None` when a new tetrahedron is not positive.
+    fn change(&self, remove: Vec<u32>, add: Vec<[u32; 4]>, point: Option<(u32, DVec3)>) -> Option<Change> {
+        let old: Vec<f64> = remove.iter().map(|&t| self.quality(self.tets[t as usize])).collect();
+        let new: Vec<f64> = match point {
+            Some((v, p)) => add.iter().map(|&t| self.quality_at(t, v, p)).collect(),
+            None => add.iter().map(|&t| self.quality(t)).collect(),
+        };
+        let change = Change::from_qualities(remove, add, point, &old, &new);
+        (change.after > INVALID).then_some(change)
+    }
+
+    /// Flip 2-3: replace the two tetrahedra on the interior face `abc` by three around the
+    /// edge joining their apexes. `None` when the face is on the boundary or a new tetrahedron
+    /// would not be positive.
+    pub fn flip_23(&self, face: [u32; 3]) -> Option<Change> {
+        let tets = self.tets_with(&face);
+        let &[s, t] = &tets[..] else { return None };
+        let apex = |t: u32| self.tets[t as usize].into_iter().find(|v| !face.contains(v));
+        let (d, e) = (apex(s)?, apex(t)?);
+        let [a, b, c] = face.map(|v| self.points[v as usize]);
+        let (top, bottom) = match orient3d(a, b, c, self.points[d as usize]) {
+            Sign::Positive => (d, e),
+            Sign::Negative => (e, d),
+            Sign::Zero => return None,
+        };
+        let add: Vec<[u32; 4]> = (0..3).map(|i| [bottom, top, face[i], face[(i + 1) % 3]]).collect();
+        self.change(tets, add, None)
+    }
+
+    /// Edge removal: replace the ring of tetrahedra around the interior edge `ab` (3 to
+    /// [`MAX_RING`] of them) by the best triangulation of the ring polygon joined to `a` and to
+    /// `b` (Shewchuk's dynamic programme); 3 tetrahedra give the 3-2 flip, 4 the 4-4 flip.
+    pub fn remove_edge(&self, a: u32, b: u32) -> Option<Change> {
+        let (tets, ring) = self.ring(a, b)?;
+        let m = ring.len();
+        if !(3..=MAX_RING).contains(&m) {
+            return None;
+        }
+        let add = self.best_ring_triangulation(a, b, &ring)?;
+        self.change(tets, add, None)
+    }
+
+    /// The triangulation of the ring polygon that maximises the worst of the tetrahedra
+    /// `(ri, rk, rj, b)` and `(rk, ri, rj, a)` over its triangles `i < k < j`; `None` when every
+    /// triangulation has a tetrahedron that is not positive.
+    fn best_ring_triangulation(&self, a: u32, b: u32, ring: &[u32]) -> Option<Vec<[u32; 4]>> {
+        let m = ring.len();
+        // best[i][j]: worst quality of the best triangulation of ring[i..=j]; split[i][j]: its apex.
+        let mut best = vec![vec![f64::INFINITY; m]; m];
+        let mut split = vec![vec![0usize; m]; m];
+        let pair = |i: usize, k: usize, j: usize| {
+            let (ri, rk, rj) = (ring[i], ring[k], ring[j]);
+            [[ri, rk, rj, b], [rk, ri, rj, a]]
+        };
+        for len in 2..m {
+            for i in 0..m - len {
+                let j = i + len;
+                best[i][j] = INVALID;
+                for k in i + 1..j {
+                    let q = best[i][k].min(best[k][j]).min(self.worst(pair(i, k, j)));
+                    if q > best[i][j] {
+                        best[i][j] = q;
+                        split[i][j] = k;
+                    }
+                }
+            }
+        }
+        if best[0][m - 1] <= INVALID {
+            return None;
+        }
+        let mut add = Vec::with_capacity(2 * (m - 2));
+        let mut stack = vec![(0, m - 1)];
+        while let Some((i, j)) = stack.pop() {
+            if j < i + 2 {
+                continue;
+            }
+            let k = split[i][j];
+            add.extend(pair(i, k, j));
+            stack.push((i, k));
+            stack.push((k, j));
+        }
+        Some(add)
+    }
+
+    /// Move the added point `v` where the worst tetrahedron at it is best.
+    pub fn smooth_vertex(&self, v: u32) -> Option<Change> {
+        if (v as usize) < self.fixed {
+            return None;
+        }
+        let ball: Vec<[u32; 4]> = self.ball[v as usize].iter().map(|&t| self.tets[t as usize]).collect();
+        let (p, _) = self.best_position(&ball, v, self.points[v as usize]);
+        let old: Vec<f64> = ball.iter().map(|&t| self.quality(t)).collect();
+        let new: Vec<f64> = ball.iter().map(|&t| self.quality_at(t, v, p)).collect();
+        Some(Change::from_qualities(Vec::new(), Vec::new(), Some((v, p)), &old, &new))
+    }
+
+    /// Insert a point on the interior edge `ab`, placed where the worst of its tetrahedra is
+    /// best.
+    pub fn split_edge(&self, a: u32, b: u32) -> Option<Change> {
+        let (tets, ring) = self.ring(a, b)?;
+        let p = self.points.len() as u32;
+        let add: Vec<[u32; 4]> = (0..ring.len())
+            .flat_map(|i| {
+                let (x, y) = (ring[i], ring[(i + 1) % ring.len()]);
+                [[a, p, x, y], [p, b, x, y]]
+            })
+            .collect();
+        let middle = 0.5 * (self.points[a as usize] + self.points[b as usize]);
+        let (position, _) = self.best_position(&add, p, middle);
+        self.change(tets, add, Some((p, position)))
+    }
+
+    /// Insert a point at `p` (then moved where its tetrahedra are best): the tetrahedra whose
+    /// circumsphere holds `p`, grown from the one holding it (found by walking from `start`)
+    /// across interior faces, are replaced by the cone from the new point over their boundary
+    /// (Bowyer-Watson). `None` when `p` is outside the region or the cone is not positive.
+    pub fn insert_point(&self, start: u32, p: DVec3) -> Option<Change> {
+        let first = self.locate(start, p)?;
+        // The tetrahedron to improve goes too, whether or not its circumsphere holds `p`.
+        let mut cavity = vec![first];
+        if start != first && self.in_circumsphere(start, p) {
+            cavity.push(start);
+        }
+        let mut i = 0;
+        while let Some(&t) = cavity.get(i) {
+            i += 1;
+            for face in self.outward_faces(t) {
+                match self.neighbour(t, face) {
+                    Some(n) if !cavity.contains(&n) && cavity.len() < 64 && self.in_circumsphere(n, p) => {
+                        cavity.push(n)
+                    }
+                    _ => {}
+                }
+            }
+        }
+        let v = self.points.len() as u32;
+        let mut add = Vec::new();
+        for &t in &cavity {
+            for face in self.outward_faces(t) {
+                if !self.neighbour(t, face).is_some_and(|n| cavity.contains(&n)) {
+                    add.push([face[0], face[2], face[1], v]);
+                }
+            }
+        }
+        let (position, _) = self.best_position(&add, v, p);
+        let new_volume: f64 = add.iter().map(|t| self.volume_at(*t, v, position)).sum();
+        let old_volume: f64 =
+            cavity.iter().map(|&t| self.volume_at(self.tets[t as usize], v, position)).sum();
+        // A cavity that is not a ball (pinched) would not be filled exactly by the cone.
+        if (new_volume - old_volume).abs() > 1e-9 * old_volume {
+            return None;
+        }
+        self.change(cavity, add, Some((v, position)))
+    }
+
+    fn volume_at(&self, tet: [u32; 4], v: u32, p: DVec3) -> f64 {
+        let [a, b, c, d] = tet.map(|u| if u == v { p } else { self.points[u as usize] });
+        crate::geometry::tet_signed_volume(a, b, c, d)
+    }
+
+    /// The faces of tetrahedron `t`, their right-hand normals pointing out of it.
+    fn outward_faces(&self, t: u32) -> [[u32; 3]; 4] {
+        let tet = self.tets[t as usize];
+        let faces = CellKind::Tetrahedron.faces();
+        std::array::from_fn(|k| [tet[faces[k][0]], tet[faces[k][1]], tet[faces[k][2]]])
+    }
+
+    /// The other tetrahedron on a face of `t` (none on the boundary).
+    fn neighbour(&self, t: u32, face: [u32; 3]) -> Option<u32> {
+        self.tets_with(&face).into_iter().find(|&s| s != t)
+    }
+
+    /// The tetrahedron holding `p`, walking from `start` across the faces `p` lies beyond;
+    /// `None` when the walk leaves the region or goes on too long.
+    fn locate(&self, start: u32, p: DVec3) -> Option<u32> {
+        let mut t = start;
+        'walk: for _ in 0..1000 {
+            for face in self.outward_faces(t) {
+                let [a, b, c] = face.map(|v| self.points[v as usize]);
+                if orient3d(a, b, c, p) == Sign::Positive {
+                    t = self.neighbour(t, face)?;
+                    continue 'walk;
+                }
+            }
+            return Some(t);
+        }
+        None
+    }
+
+    /// Whether `p` is inside the circumsphere of tetrahedron `t` (floating point: it only
+    /// chooses the cavity, whose cone is then checked exactly).
+    fn in_circumsphere(&self, t: u32, p: DVec3) -> bool {
+        let x = self.corners(self.tets[t as usize]);
+        circumcentre(x).is_some_and(|centre| (p - centre).length_squared() < (x[0] - centre).length_squared())
+    }
+
+    /// Where to insert a point for tetrahedron `t`: the best apex over each of its boundary
+    /// faces, and its circumcentre.
+    fn insertion_points(&self, t: u32) -> Vec<DVec3> {
+        let mut points: Vec<DVec3> = self
+            .outward_faces(t)
+            .into_iter()
+            .filter(|&face| self.neighbour(t, face).is_none())
+            .map(|f| {
+                let [a, b, c] = f.map(|v| self.points[v as usize]);
+                best_apex(a, c, b).0
+            })
+            .collect();
+        points.extend(circumcentre(self.corners(self.tets[t as usize])));
+        points
+    }
+
+    /// Worst quality of `ball` (tetrahedra at `v`) with `v` at `p`.
+    fn ball_quality(&self, ball: &[[u32; 4]], v: u32, p: DVec3) -> f64 {
+        ball.iter().map(|t| self.quality_at(*t, v, p)).fold(f64::INFINITY, f64::min)
+    }
+
+    fn quality_at(&self, tet: [u32; 4], v: u32, p: DVec3) -> f64 {
+        angle_quality(tet.map(|u| if u == v { p } else { self.points[u as usize] }))
+    }
+
+    /// Hill climbing on the worst tetrahedron of `ball` from `start`: first the centroid of
+    /// the ball's other nodes, then steps along the gradient of the worst angle(s).
+    fn best_position(&self, ball: &[[u32; 4]], v: u32, start: DVec3) -> (DVec3, f64) {
+        let mut others: Vec<u32> = ball.iter().flatten().copied().filter(|&u| u != v).collect();
+        others.sort_unstable();
+        others.dedup();
+        if others.is_empty() {
+            return (start, self.ball_quality(ball, v, start));
+        }
+        let centroid = others.iter().map(|&u| self.points[u as usize]).sum::<DVec3>() / others.len() as f64;
+        let scale = others.iter().map(|&u| (self.points[u as usize] - centroid).length()).sum::<f64>()
+            / others.len() as f64;
+        let (mut p, mut q) = (start, self.ball_quality(ball, v, start));
+        let qc = self.ball_quality(ball, v, centroid);
+        if qc > q {
+            (p, q) = (centroid, qc);
+        }
+        for _ in 0..12 {
+            let Some(direction) = self.ascent_direction(ball, v, p, q, scale) else { break };
+            let mut step = 0.25 * scale;
+            let mut moved = false;
+            for _ in 0..8 {
+                let candidate = p + step * direction;
+                let qn = self.ball_quality(ball, v, candidate);
+                if qn > q {
+                    (p, q, moved) = (candidate, qn, true);
+                    break;
+                }
+                step *= 0.5;
+            }
+            if !moved {
+                break;
+            }
+        }
+        (p, q)
+    }
+
+    /// The normalised sum of the normalised gradients of the tetrahedra within a degree of
+    /// the worst (numerical, central differences).
+    fn ascent_direction(&self, ball: &[[u32; 4]], v: u32, p: DVec3, worst: f64, scale: f64) -> Option<DVec3> {
+        let h = 1e-5 * scale;
+        let mut direction = DVec3::ZERO;
+        for &tet in ball {
+            if self.quality_at(tet, v, p) > worst + 1.0 {
+                continue;
+            }
+            let derivative = |e: DVec3| {
+                (self.quality_at(tet, v, p + h * e) - self.quality_at(tet, v, p - h * e)) / (2.0 * h)
+            };
+            let gradient = DVec3::new(derivative(DVec3::X), derivative(DVec3::Y), derivative(DVec3::Z));
+            direction += gradient.normalize_or_zero();
+        }
+        let direction = direction.normalize_or_zero();
+        (direction != DVec3::ZERO && direction.is_finite()).then_some(direction)
+    }
+
+    /// The change the operators propose for tetrahedron `t`: the best flip, else the best
+    /// smoothing of one of its points, else the best point insertion, if one helps.
+    fn improve_tet(
+        &self,
+        t: u32,
+        options: &ImproveOptions,
+        rule: Rule,
+        stats: &mut ImproveStats,
+    ) -> Option<Change> {
+        let tet = self.tets[t as usize];
+        let mut flips: Vec<Change> =
+            TET_EDGES.iter().filter_map(|&(i, j)| self.remove_edge(tet[i], tet[j])).collect();
+        flips.extend(
+            CellKind::Tetrahedron
+                .faces()
+                .iter()
+                .filter_map(|f| self.flip_23([tet[f[0]], tet[f[1]], tet[f[2]]])),
+        );
+        if let Some(change) = best_improving(flips, rule) {
+            match (change.remove.len(), change.add.len()) {
+                (2, 3) => stats.flips_23 += 1,
+                (3, 2) => stats.flips_32 += 1,
+                (4, 4) => stats.flips_44 += 1,
+                _ => stats.edge_removals += 1,
+            }
+            return Some(change);
+        }
+        let smoothing = tet.iter().filter_map(|&v| self.smooth_vertex(v)).collect();
+        if let Some(change) = best_improving(smoothing, rule) {
+            stats.smoothed_points += 1;
+            return Some(change);
+        }
+        // Insertion under the worst-first rule trades one sliver for many slightly better ones.
+        if !options.insert_points || rule == Rule::WorstFirst {
+            return None;
+        }
+        let mut insertions: Vec<Change> =
+            TET_EDGES.iter().filter_map(|&(i, j)| self.split_edge(tet[i], tet[j])).collect();
+        insertions.extend(self.insertion_points(t).into_iter().filter_map(|p| self.insert_point(t, p)));
+        // Nearer the tetrahedron, the cavity is smaller and more often star-shaped.
+        let centre = self.corners(tet).iter().sum::<DVec3>() / 4.0;
+        insertions.extend(
+            self.insertion_points(t).into_iter().filter_map(|p| self.insert_point(t, 0.5 * (p + centre))),
+        );
+        let change = best_improving(insertions, rule)?;
+        stats.inserted_points += 1;
+        Some(change)
+    }
+
+    /// Passes over the tetrahedra below the target angle, worst first.
+    /// Passes over the tetrahedra below the target quality, worst first: first changes that
+    /// leave fewer bad tetrahedra, then, for those still below [`SLIVER_THRESHOLD`], any change
+    /// that raises the worst angle.
+    pub fn improve(&mut self, options: &ImproveOptions) -> ImproveStats {
+        let start = Instant::now();
+        let mut stats = ImproveStats::default();
+        self.passes(options.passes, options, Rule::FewerBad, options.target_dihedral, &mut stats);
+        let worst_first = options.passes.min(WORST_FIRST_PASSES);
+        self.passes(
+            worst_first,
+            options,
+            Rule::WorstFirst,
+            options.target_dihedral.min(SLIVER_THRESHOLD),
+            &mut stats,
+        );
+        stats.seconds = start.elapsed().as_secs_f64();
+        stats
+    }
+
+    fn passes(
+        &mut self,
+        passes: usize,
+        options: &ImproveOptions,
+        rule: Rule,
+        target: f64,
+        stats: &mut ImproveStats,
+    ) {
+        // A tetrahedron no operator helped is tried again only once something changed at one
+        // of its nodes: `failed[t]` is the pass it failed in, `changed[v]` the last pass that
+        // changed the tetrahedra at point `v` or moved it.
+        let mut failed: Vec<Option<usize>> = vec![None; self.tets.len()];
+        let mut changed = vec![0usize; self.points.len()];
+        for pass in 1..=passes {
+            let stale = |t: usize, tet: &[u32; 4]| {
+                failed[t].is_some_and(|f| tet.iter().all(|&v| changed[v as usize] < f))
+            };
+            let mut bad: Vec<(f64, u32)> = (0..self.tets.len())
+                .filter(|&t| self.alive[t] && !stale(t, &self.tets[t]))
+                .map(|t| (self.quality(self.tets[t]), t as u32))
+                .filter(|&(q, _)| q < target)
+                .collect();
+            if bad.is_empty() {
+                break;
+            }
+            stats.passes += 1;
+            bad.sort_by(|x, y| x.0.total_cmp(&y.0));
+            for (_, t) in bad {
+                if !self.alive[t as usize] {
+                    continue;
+                }
+                match self.improve_tet(t, options, rule, stats) {
+                    Some(change) => {
+                        let touched = change
+                            .remove
+                            .iter()
+                            .map(|&s| self.tets[s as usize])
+                            .chain(change.add.iter().copied());
+                        let nodes: Vec<u32> = touched.flatten().chain(change.point.map(|p| p.0)).collect();
+                        self.apply(&change);
+                        changed.resize(self.points.len(), 0);
+                        failed.resize(self.tets.len(), None);
+                        for v in nodes {
+                            changed[v as usize] = pass;
+                        }
+                    }
+                    None => failed[t as usize] = Some(pass),
+                }
+            }
+        }
+    }
+}
+
+/// The centre of the sphere through the corners of a tetrahedron (none when it is flat).
+fn circumcentre([a, b, c, d]: [DVec3; 4]) -> Option<DVec3> {
+    let (u, v, w) = (b - a, c - a, d - a);
+    let denominator = 2.0 * u.dot(v.cross(w));
+    let centre =
+        (u.length_squared() * v.cross(w) + v.length_squared() * w.cross(u) + w.length_squared() * u.cross(v))
+            / denominator;
+    (denominator != 0.0 && centre.is_finite()).then_some(a + centre)
+}
+
+/// The change that raises the worst angle most, if any does by the rule.
+fn best_improving(changes: Vec<Change>, rule: Rule) -> Option<Change> {
+    changes.into_iter().filter(|c| c.improves(rule)).max_by(|x, y| x.after.total_cmp(&y.after))
+}
+
+/// When a change is an improvement.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+enum Rule {
+    /// The worst angle rises and no more tetrahedra are left below [`COUNTED_BELOW`] (or only
+    /// two more, for a much better worst angle).
+    FewerBad,
+    /// The worst angle rises.
+    WorstFirst,
+}
+
+/// The other two nodes `(x, y)` of `tet` (positive, with nodes `a` and `b`) ordered so that
+/// `(a, b, x, y)` is an even permutation of it, hence positive too.
+fn ring_pair(tet: [u32; 4], a: u32, b: u32) -> (u32, u32) {
+    let position = |v: u32| tet.iter().position(|&u| u == v).unwrap_or(0);
+    let rest: Vec<usize> = (0..4).filter(|&i| tet[i] != a && tet[i] != b).collect();
+    let (x, y) = (rest.first().copied().unwrap_or(0), rest.get(1).copied().unwrap_or(0));
+    let order = [position(a), position(b), x, y];
+    let inversions =
+        (0..4).flat_map(|i| (i + 1..4).map(move |j| (i, j))).filter(|&(i, j)| order[i] > order[j]).count();
+    if inversions % 2 == 0 {
+        (tet[x], tet[y])
+    } else {
+        (tet[y], tet[x])
+    }
+}
+
+/// Width of the bins of a [`DihedralHistogram`], degrees.
+pub const HISTOGRAM_BIN: f64 = 5.0;
+
+/// Histogram of the smallest dihedral angle of tetrahedra: `counts[i]` tetrahedra have it in
+/// `[i, i + 1) * bin_degrees` (the largest possible, 70.5 degrees, is in the last bin).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct DihedralHistogram {
+    pub bin_degrees: f64,
+    pub counts: Vec<usize>,
+}
+
+impl DihedralHistogram {
+    pub fn of(points: &[DVec3], tets: &[[u32; 4]]) -> DihedralHistogram {
+        let mut counts = vec![0; 15];
+        for tet in tets {
+            let q = min_dihedral(tet.map(|v| points[v as usize]));
+            let bin = ((q.max(0.0) / HISTOGRAM_BIN) as usize).min(counts.len() - 1);
+            counts[bin] += 1;
+        }
+        DihedralHistogram { bin_degrees: HISTOGRAM_BIN, counts }
+    }
+}
+
+impl std::fmt::Display for DihedralHistogram {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let bins = self.counts.iter().enumerate().map(|(i, n)| {
+            let lo = i as f64 * self.bin_degrees;
+            format!("{lo:.0}-{:.0}: {n}", lo + self.bin_degrees)
+        });
+        write!(f, "{}", bins.collect::<Vec<_>>().join(", "))
+    }
+}
+
+/// Why a tetrahedron below the threshold angle is there.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+pub enum SliverCause {
+    /// At one of its boundary edges the region's angle (between the two boundary triangles
+    /// there) is below the threshold, so every tetrahedron at that edge has a smaller angle.
+    BoundaryAngle,
+    /// A boundary triangle of it is so badly shaped that no tetrahedron on it reaches the
+    /// threshold.
+    BoundaryTriangle,
+    /// The region is thin there: across the boundary triangle nearest to it, the region is
+    /// `w` wide, and every tetrahedron on that triangle (inradius `r`) has a dihedral angle at
+    /// most about `atan(w / r)`, which is below the threshold.
+    ThinGap,
+    /// Nothing in the boundary forces it.
+    NotForced,
+}
+
+/// A tetrahedron below the threshold angle, where it is and what it touches.
+#[derive(Clone, Debug, Serialize)]
+pub struct Sliver {
+    pub centre: [f64; 3],
+    pub min_dihedral: f64,
+    pub cause: SliverCause,
+    /// The smallest angle of the region at its boundary edges (sum of the dihedral angles of
+    /// the tetrahedra there; `null`: no boundary edge).
+    pub boundary_edge_angle: f64,
+    /// Its faces on the boundary, and its nodes on a front, wall or farfield triangle (a node
+    /// where a front and a wall meet counts in both) or inside.
+    pub boundary_faces: usize,
+    /// Width of the region across the nearest boundary triangle, and that triangle's inradius
+    /// (`atan(width / inradius)` bounds the angles of tetrahedra on it).
+    pub gap_width: f64,
+    pub nearest_inradius: f64,
+    pub front_nodes: usize,
+    pub wall_nodes: usize,
+    pub farfield_nodes: usize,
+    pub interior_nodes: usize,
+}
+
+/// The tetrahedra left below the threshold angle, by cause.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct SliverCensus {
+    pub threshold: f64,
+    pub count: usize,
+    pub boundary_angle: usize,
+    pub boundary_triangle: usize,
+    pub thin_gap: usize,
+    pub not_forced: usize,
+    /// Of all of them, those with their four nodes on the boundary (no point to move: only a
+    /// point inserted near them can remove them).
+    pub all_nodes_on_boundary: usize,
+    /// The worst few.
+    pub examples: Vec<Sliver>,
+}
+
+/// Dihedral angle at edge `(i, j)` of tetrahedron `x`, degrees.
+fn dihedral_at(x: [DVec3; 4], i: usize, j: usize) -> f64 {
+    let rest: Vec<usize> = (0..4).filter(|&k| k != i && k != j).collect();
+    let e = (x[j] - x[i]).normalize_or_zero();
+    let off = |k: usize| {
+        let d = x[k] - x[i];
+        (d - e * d.dot(e)).normalize_or_zero()
+    };
+    off(rest[0]).dot(off(rest[1])).clamp(-1.0, 1.0).acos().to_degrees()
+}
+
+/// The best [`angle_quality`] of a tetrahedron on triangle `(a, b, c)` (apex on the side its
+/// right-hand normal points to): no tetrahedron on it has all its dihedral angles further from
+/// 0 and 180 degrees.
+pub fn best_apex_quality(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    best_apex(a, b, c).1
+}
+
+/// The apex of [`best_apex_quality`] and its quality.
+fn best_apex(a: DVec3, b: DVec3, c: DVec3) -> (DVec3, f64) {
+    let normal = (b - a).cross(c - a).normalize_or_zero();
+    let edge = ((b - a).length() + (c - b).length() + (a - c).length()) / 3.0;
+    let apex = (a + b + c) / 3.0 + normal * edge * (2.0f64 / 3.0).sqrt();
+    let single = TetMesh::new(vec![a, b, c, apex], vec![[0, 1, 2, 3]], 3);
+    single.best_position(&[[0, 1, 2, 3]], 3, apex)
+}
+
+/// Which boundary triangles (marker bits) every boundary point is on.
+fn node_markers(boundary: &ClosedBoundary) -> Vec<u8> {
+    let mut bits = vec![0u8; boundary.points.len()];
+    for (t, &m) in boundary.triangles.iter().zip(&boundary.markers) {
+        for &v in t {
+            bits[v as usize] |= 1 << m.min(7);
+        }
+    }
+    bits
+}
+
+impl SliverCensus {
+    /// Classify the tetrahedra of `core` (filling `boundary`) below `threshold` degrees.
+    pub fn of(boundary: &ClosedBoundary, core: &CoreTets, threshold: f64) -> SliverCensus {
+        let corners = |tet: [u32; 4]| tet.map(|v| core.points[v as usize]);
+        let mut found: Vec<([u32; 4], f64)> = core
+            .tets
+            .iter()
+            .map(|&tet| (tet, min_dihedral(corners(tet))))
+            .filter(|&(_, q)| q < threshold)
+            .collect();
+        found.sort_by(|s, t| s.1.total_cmp(&t.1));
+        let faces: HashSet<[u32; 3]> = boundary.triangles.iter().map(|&t| sorted_triangle(t)).collect();
+        let edge_angle = boundary_edge_angles(boundary, core, found.iter().map(|s| s.0));
+        let bits = node_markers(boundary);
+        let bvh = TriangleBvh::new(
+            boundary.triangles.iter().map(|t| t.map(|v| boundary.points[v as usize])).collect(),
+        );
+        let mut census = SliverCensus { threshold, count: found.len(), ..Default::default() };
+        for (tet, q) in found {
+            let x = corners(tet);
+            let on_boundary: Vec<[usize; 3]> = CellKind::Tetrahedron
+                .faces()
+                .iter()
+                .map(|f| [f[0], f[1], f[2]])
+                .filter(|f| faces.contains(&sorted_triangle(f.map(|i| tet[i]))))
+                .collect();
+            let boundary_edge_angle = TET_EDGES
+                .iter()
+                .filter_map(|&(i, j)| edge_angle.get(&sorted_edge(tet[i], tet[j])))
+                .fold(f64::INFINITY, |a, &b| a.min(b));
+            let interior_nodes = tet.iter().filter(|&&v| v as usize >= boundary.points.len()).count();
+            census.all_nodes_on_boundary += usize::from(interior_nodes == 0);
+            let centre = x.iter().sum::<DVec3>() / 4.0;
+            let (gap_width, nearest_inradius) = gap_across_nearest(&bvh, centre);
+            let cause = if boundary_edge_angle < threshold {
+                census.boundary_angle += 1;
+                SliverCause::BoundaryAngle
+            } else if on_boundary.iter().any(|f| best_apex_quality(x[f[0]], x[f[2]], x[f[1]]) < threshold) {
+                // The faces of CellKind::Tetrahedron point out of the cell: reversed, into it.
+                census.boundary_triangle += 1;
+                SliverCause::BoundaryTriangle
+            } else if gap_width.atan2(nearest_inradius).to_degrees() < threshold {
+                census.thin_gap += 1;
+                SliverCause::ThinGap
+            } else {
+                census.not_forced += 1;
+                SliverCause::NotForced
+            };
+            if census.examples.len() < 10 {
+                let has = |v: u32, m: u32| bits.get(v as usize).is_some_and(|b| b & (1 << m) != 0);
+                let count = |m: u32| tet.iter().filter(|&&v| has(v, m)).count();
+                census.examples.push(Sliver {
+                    centre: centre.to_array(),
+                    min_dihedral: q,
+                    cause,
+                    boundary_faces: on_boundary.len(),
+                    boundary_edge_angle,
+                    gap_width,
+                    nearest_inradius,
+                    front_nodes: count(MARKER_FRONT),
+                    wall_nodes: count(MARKER_WALL),
+                    farfield_nodes: count(MARKER_FARFIELD),
+                    interior_nodes,
+                });
+            }
+        }
+        census
+    }
+}
+
+fn sorted_edge(a: u32, b: u32) -> [u32; 2] {
+    [a.min(b), a.max(b)]
+}
+
+/// The angle of the region (sum of the dihedral angles of the tetrahedra of `core` there,
+/// degrees) at every boundary edge of the tetrahedra `of`.
+fn boundary_edge_angles(
+    boundary: &ClosedBoundary,
+    core: &CoreTets,
+    of: impl Iterator<Item = [u32; 4]>,
+) -> HashMap<[u32; 2], f64> {
+    let edges: HashSet<[u32; 2]> = boundary
+        .triangles
+        .iter()
+        .flat_map(|t| [sorted_edge(t[0], t[1]), sorted_edge(t[1], t[2]), sorted_edge(t[2], t[0])])
+        .collect();
+    let mut angle: HashMap<[u32; 2], f64> = of
+        .flat_map(|tet| TET_EDGES.map(|(i, j)| sorted_edge(tet[i], tet[j])))
+        .filter(|e| edges.contains(e))
+        .map(|e| (e, 0.0))
+        .collect();
+    if angle.is_empty() {
+        return angle;
+    }
+    for &tet in &core.tets {
+        for (i, j) in TET_EDGES {
+            if let Some(sum) = angle.get_mut(&sorted_edge(tet[i], tet[j])) {
+                *sum += dihedral_at(tet.map(|v| core.points[v as usize]), i, j);
+            }
+        }
+    }
+    angle
+}
+
+/// The width of the region across the boundary triangle nearest to `p` (from the nearest
+/// point along the triangle's normal, into the region, to the next boundary triangle; infinite
+/// when none is hit) and that triangle's inradius.
+fn gap_across_nearest(bvh: &TriangleBvh, p: DVec3) -> (f64, f64) {
+    let Some(near) = bvh.nearest(p) else { return (f64::INFINITY, 0.0) };
+    let [a, b, c] = bvh.corners(near.triangle);
+    let area = triangle_area_vector(a, b, c);
+    let inradius = area.length() / ((b - a).length() + (c - b).length() + (a - c).length());
+    let direction = area.normalize_or_zero();
+    // Hits closer than this are the nearest triangle's neighbours at the starting point.
+    let skip = 1e-9 * inradius;
+    let mut best = f64::INFINITY;
+    bvh.branch_and_bound(
+        |bounds| ray_box_entry(near.point, direction, bounds),
+        |t, corners| {
+            if t != near.triangle {
+                if let Some(s) = ray_triangle(near.point, direction, corners).filter(|&s| s > skip) {
+                    best = best.min(s);
+                }
+            }
+            best
+        },
+    );
+    (best, inradius)
+}
+
+/// Where the ray `origin + s direction`, `s >= 0`, enters the box (0 inside it; infinite if
+/// it misses).
+fn ray_box_entry(origin: DVec3, direction: DVec3, bounds: &Aabb) -> f64 {
+    let (mut enter, mut leave) = (0.0f64, f64::INFINITY);
+    for axis in 0..3 {
+        let (o, d) = (origin[axis], direction[axis]);
+        let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
+        if d == 0.0 {
+            if o < lo || o > hi {
+                return f64::INFINITY;
+            }
+            continue;
+        }
+        let (s0, s1) = ((lo - o) / d, (hi - o) / d);
+        enter = enter.max(s0.min(s1));
+        leave = leave.min(s0.max(s1));
+    }
+    if enter <= leave {
+        enter
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The ray parameter where `origin + s direction` crosses the triangle (Moller-Trumbore;
+/// floating point: the census only measures).
+fn ray_triangle(origin: DVec3, direction: DVec3, [a, b, c]: &[DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (*b - *a, *c - *a);
+    let h = direction.cross(e2);
+    let det = e1.dot(h);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let offset = origin - *a;
+    let u = offset.dot(h) / det;
+    let q = offset.cross(e1);
+    let v = direction.dot(q) / det;
+    let s = e2.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s >= 0.0).then_some(s)
+}
+
+/// What the improvement found and did, for the report.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct CoreQuality {
+    /// Smallest dihedral angle of the mesher's tetrahedra and their histogram, before.
+    pub mesher_min_dihedral: f64,
+    pub mesher_histogram: DihedralHistogram,
+    /// After the improvement.
+    pub min_dihedral: f64,
+    pub histogram: DihedralHistogram,
+    pub improvement: ImproveStats,
+    /// The tetrahedra left below [`SLIVER_THRESHOLD`] degrees.
+    pub slivers: SliverCensus,
+}
+
+/// The core's quality bar: no tetrahedron with a dihedral angle below this, degrees.
+pub const SLIVER_THRESHOLD: f64 = 10.0;
+
+/// Improve the mesher's tetrahedra (`core`, filling `boundary`, whose points come first and
+/// stay) and measure them before and after.
+pub fn improve_core(
+    boundary: &ClosedBoundary,
+    core: CoreTets,
+    options: &ImproveOptions,
+) -> (CoreTets, CoreQuality) {
+    let worst = |points: &[DVec3], tets: &[[u32; 4]]| {
+        tets.iter().map(|t| min_dihedral(t.map(|v| points[v as usize]))).fold(f64::INFINITY, f64::min)
+    };
+    let mesher_min_dihedral = worst(&core.points, &core.tets);
+    let mesher_histogram = DihedralHistogram::of(&core.points, &core.tets);
+    let mut mesh = TetMesh::new(core.points, core.tets, boundary.points.len());
+    let improvement = mesh.improve(options);
+    let (points, tets) = mesh.into_parts();
+    let core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };
+    let quality = CoreQuality {
+        mesher_min_dihedral,
+        mesher_histogram,
+        min_dihedral: worst(&core.points, &core.tets),
+        histogram: DihedralHistogram::of(&core.points, &core.tets),
+        improvement,
+        slivers: SliverCensus::of(boundary, &core, SLIVER_THRESHOLD),
+    };
+    (core, quality)
+}
+
+#[cfg(test)]
+mod tests;

@@ -1,0 +1,240 @@
+use std::collections::HashMap;
+
+use proptest::prelude::*;
+
+use super::*;
+use crate::geometry::tet_signed_volume;
+use crate::quality::samples::{cube_grid, CubeSplit};
+
+/// The faces of the mesh (sorted nodes) with the number of tetrahedra on each.
+fn face_counts(mesh: &TetMesh) -> HashMap<[u32; 3], usize> {
+    let mut count = HashMap::new();
+    for tet in mesh.tets() {
+        for f in CellKind::Tetrahedron.faces() {
+            *count.entry(sorted_triangle([tet[f[0]], tet[f[1]], tet[f[2]]])).or_insert(0) += 1;
+        }
+    }
+    count
+}
+
+fn boundary_faces(mesh: &TetMesh) -> Vec<[u32; 3]> {
+    let mut faces: Vec<[u32; 3]> =
+        face_counts(mesh).into_iter().filter(|(_, n)| *n == 1).map(|(f, _)| f).collect();
+    faces.sort_unstable();
+    faces
+}
+
+fn volume(mesh: &TetMesh) -> f64 {
+    mesh.tets()
+        .map(|t| t.map(|v| mesh.points[v as usize]))
+        .map(|[a, b, c, d]| tet_signed_volume(a, b, c, d))
+        .sum()
+}
+
+/// Every tetrahedron positive (exact), no face on more than two, the boundary and the volume as
+/// in `reference`, the fixed points where they were.
+fn assert_consistent(mesh: &TetMesh, reference: &TetMesh) {
+    for tet in mesh.tets() {
+        let [a, b, c, d] = tet.map(|v| mesh.points[v as usize]);
+        assert_eq!(orient3d(a, b, c, d), Sign::Positive, "{tet:?}");
+    }
+    assert!(face_counts(mesh).values().all(|&n| n <= 2), "a face on more than two tetrahedra");
+    assert_eq!(boundary_faces(mesh), boundary_faces(reference));
+    let (v, w) = (volume(mesh), volume(reference));
+    assert!((v - w).abs() <= 1e-12 * w.abs(), "volume {v} vs {w}");
+    assert_eq!(mesh.points[..mesh.fixed], reference.points[..reference.fixed]);
+}
+
+/// Tetrahedra around the edge from `bottom` to `top` (nodes 0 and 1) with a regular ring of
+/// `m` nodes (2..) around it at height `z`; a wiggle moves every other ring node up.
+fn ring_mesh(m: usize, z: f64, wiggle: f64) -> TetMesh {
+    let mut points = vec![DVec3::new(0.0, 0.0, -1.0), DVec3::new(0.0, 0.0, 1.0)];
+    for i in 0..m {
+        let angle = std::f64::consts::TAU * i as f64 / m as f64;
+        let up = if i % 2 == 0 { wiggle } else { 0.0 };
+        points.push(DVec3::new(angle.cos(), angle.sin(), z + up));
+    }
+    let ring = |i: usize| 2 + (i % m) as u32;
+    let tets = (0..m).map(|i| [0, 1, ring(i), ring(i + 1)]).collect();
+    TetMesh::new(points, tets, 2 + m)
+}
+
+#[test]
+fn ring_order_makes_positive_tetrahedra() {
+    let mesh = ring_mesh(5, 0.0, 0.0);
+    let (tets, ring) = mesh.ring(0, 1).unwrap();
+    assert_eq!(tets.len(), 5);
+    for i in 0..5 {
+        let tet = [0, 1, ring[i], ring[(i + 1) % 5]];
+        assert!(mesh.quality(tet) > 0.0, "{tet:?}");
+    }
+    // A boundary edge has no closed ring.
+    assert!(mesh.ring(0, 2).is_none());
+}
+
+#[test]
+fn flip_32_removes_the_edge_of_a_flat_ring() {
+    // Three tetrahedra around a long edge: the two across the ring are better.
+    let mesh = ring_mesh(3, 0.0, 0.0);
+    let change = mesh.remove_edge(0, 1).unwrap();
+    assert_eq!((change.remove.len(), change.add.len()), (3, 2));
+    assert!(change.improves(Rule::FewerBad), "{change:?}");
+    let mut after = mesh.clone();
+    after.apply(&change);
+    assert_consistent(&after, &mesh);
+    assert!(after.tets().all(|t| !(t.contains(&0) && t.contains(&1))));
+}
+
+#[test]
+fn flip_23_is_the_inverse_of_flip_32() {
+    let mut mesh = ring_mesh(3, 0.0, 0.0);
+    let reference = mesh.clone();
+    mesh.apply(&mesh.remove_edge(0, 1).unwrap());
+    let change = mesh.flip_23([2, 3, 4]).unwrap();
+    assert_eq!((change.remove.len(), change.add.len()), (2, 3));
+    mesh.apply(&change);
+    assert_consistent(&mesh, &reference);
+    assert_eq!(mesh.tets_with(&[0, 1]).len(), 3);
+    // A face on the boundary cannot flip.
+    assert!(mesh.flip_23([0, 2, 3]).is_none());
+}
+
+#[test]
+fn flip_44_and_larger_edge_removals_keep_the_cavity() {
+    for m in 4..=MAX_RING {
+        let mesh = ring_mesh(m, 0.0, 0.1);
+        let change = mesh.remove_edge(0, 1).unwrap();
+        assert_eq!((change.remove.len(), change.add.len()), (m, 2 * (m - 2)), "ring of {m}");
+        let mut after = mesh.clone();
+        after.apply(&change);
+        assert_consistent(&after, &mesh);
+    }
+    // Rings above the limit are left alone.
+    assert!(ring_mesh(MAX_RING + 1, 0.0, 0.0).remove_edge(0, 1).is_none());
+}
+
+#[test]
+fn edge_removal_refuses_a_ring_that_cannot_be_rebuilt() {
+    // The ring polygon lies far above both ends of the edge: joining it to the bottom node
+    // makes tetrahedra of the wrong orientation.
+    let mesh = ring_mesh(3, 2.0, 0.0);
+    assert!(mesh.tets().all(|t| mesh.quality(t) > 0.0));
+    assert!(mesh.remove_edge(0, 1).is_none());
+}
+
+#[test]
+fn split_edge_adds_an_interior_point_and_keeps_the_cavity() {
+    let mesh = ring_mesh(4, 0.0, 0.0);
+    let change = mesh.split_edge(0, 1).unwrap();
+    assert_eq!((change.remove.len(), change.add.len()), (4, 8));
+    assert_eq!(change.point.map(|p| p.0), Some(6));
+    let mut after = mesh.clone();
+    after.apply(&change);
+    assert_eq!(after.points.len(), 7);
+    assert_consistent(&after, &mesh);
+}
+
+#[test]
+fn smoothing_moves_only_added_points_and_raises_the_worst_angle() {
+    // A point added at the centre of an octahedron, pulled near a corner.
+    let mut mesh = ring_mesh(4, 0.0, 0.0);
+    mesh.apply(&mesh.split_edge(0, 1).unwrap());
+    mesh.points[6] = DVec3::new(0.9, 0.0, 0.05);
+    let reference = mesh.clone();
+    let change = mesh.smooth_vertex(6).unwrap();
+    assert!(change.after > change.before + 10.0, "{change:?}");
+    mesh.apply(&change);
+    assert_consistent(&mesh, &reference);
+    assert!(mesh.smooth_vertex(0).is_none(), "node 0 is fixed");
+}
+
+#[test]
+fn histogram_counts_every_tetrahedron() {
+    let mesh = ring_mesh(6, 0.0, 0.0);
+    let (points, tets) = mesh.into_parts();
+    let h = DihedralHistogram::of(&points, &tets);
+    assert_eq!(h.counts.iter().sum::<usize>(), 6);
+    assert!(h.to_string().starts_with("0-5: "));
+}
+
+#[test]
+fn a_cap_has_no_good_tetrahedron_but_a_needle_and_an_equilateral_triangle_have() {
+    let equilateral = best_apex_quality(DVec3::ZERO, DVec3::X, DVec3::new(0.5, 0.75f64.sqrt(), 0.0));
+    assert!(equilateral > 65.0, "{equilateral}");
+    let cap = best_apex_quality(DVec3::ZERO, DVec3::X, DVec3::new(0.5, 0.01, 0.0));
+    assert!(cap < 10.0, "{cap}");
+    // A needle has a good tetrahedron: the apex near its short edge (a needle too).
+    let needle = best_apex_quality(DVec3::ZERO, DVec3::X, DVec3::new(0.0, 0.02, 0.0));
+    assert!(needle > 10.0, "{needle}");
+}
+
+/// A grid of `n`^3 cubes cut into Kuhn tetrahedra, interior points moved by `jitter` (in grid
+/// cells) and numbered after the boundary points, which are fixed.
+fn jittered_grid(n: usize, jitter: &[f64]) -> Option<TetMesh> {
+    let grid = cube_grid([n; 3], DVec3::ONE, &|_| CubeSplit::Tetrahedra, &|_| 0);
+    let inside = |p: DVec3| p.cmpgt(DVec3::ZERO).all() && p.cmplt(DVec3::splat(n as f64)).all();
+    let mut order: Vec<usize> = (0..grid.points.len()).collect();
+    order.sort_by_key(|&i| inside(grid.points[i]));
+    let mut new_index = vec![0u32; order.len()];
+    for (k, &i) in order.iter().enumerate() {
+        new_index[i] = k as u32;
+    }
+    let fixed = order.iter().filter(|&&i| !inside(grid.points[i])).count();
+    let mut points: Vec<DVec3> = order.iter().map(|&i| grid.points[i]).collect();
+    for (k, p) in points.iter_mut().enumerate().skip(fixed) {
+        let j = 3 * (k - fixed);
+        *p += DVec3::new(
+            jitter[j % jitter.len()],
+            jitter[(j + 1) % jitter.len()],
+            jitter[(j + 2) % jitter.len()],
+        );
+    }
+    let block = grid.block(CellKind::Tetrahedron);
+    let tets: Vec<[u32; 4]> = block.iter().map(|t| [0, 1, 2, 3].map(|i| new_index[t[i] as usize])).collect();
+    let mesh = TetMesh::new(points, tets, fixed);
+    let valid = mesh.tets().all(|t| mesh.quality(t) > 0.0);
+    valid.then_some(mesh)
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(24))]
+
+    /// Any sequence of operators on a jittered grid keeps the mesh valid, conforming, with the
+    /// same boundary and volume.
+    #[test]
+    fn operators_keep_the_mesh_valid(
+        jitter in proptest::collection::vec(-0.35f64..0.35, 30),
+        ops in proptest::collection::vec((0usize..4, 0usize..10_000, 0usize..6), 1..40),
+    ) {
+        let Some(mut mesh) = jittered_grid(3, &jitter) else { return Ok(()) };
+        let reference = mesh.clone();
+        for (op, pick, local) in ops {
+            let live: Vec<[u32; 4]> = mesh.tets().collect();
+            let tet = live[pick % live.len()];
+            let (i, j) = TET_EDGES[local];
+            let f = CellKind::Tetrahedron.faces()[local % 4];
+            let change = match op {
+                0 => mesh.flip_23([tet[f[0]], tet[f[1]], tet[f[2]]]),
+                1 => mesh.remove_edge(tet[i], tet[j]),
+                2 => mesh.split_edge(tet[i], tet[j]),
+                _ => mesh.smooth_vertex(tet[local % 4]),
+            };
+            if let Some(change) = change {
+                prop_assert!(change.after > INVALID);
+                mesh.apply(&change);
+            }
+        }
+        assert_consistent(&mesh, &reference);
+    }
+
+    /// The improvement never lowers the worst angle and keeps the mesh consistent.
+    #[test]
+    fn improvement_never_lowers_the_worst_angle(jitter in proptest::collection::vec(-0.4f64..0.4, 30)) {
+        let Some(mut mesh) = jittered_grid(3, &jitter) else { return Ok(()) };
+        let reference = mesh.clone();
+        let before = mesh.worst(mesh.tets());
+        mesh.improve(&ImproveOptions { target_dihedral: 30.0, ..Default::default() });
+        assert_consistent(&mesh, &reference);
+        prop_assert!(mesh.worst(mesh.tets()) >= before);
+    }
+}
