@@ -226,6 +226,18 @@ impl Config {
         Ok(())
     }
 
+    /// The `[[patch]]` patterns that match none of `patch_names` (most likely a mistake).
+    pub fn unmatched_rules(&self, patch_names: &[String]) -> Vec<&str> {
+        self.patches
+            .iter()
+            .filter(|rule| {
+                let whole = format!("^(?:{})$", rule.pattern);
+                regex::Regex::new(&whole).is_ok_and(|re| !patch_names.iter().any(|n| re.is_match(n)))
+            })
+            .map(|rule| rule.pattern.as_str())
+            .collect()
+    }
+
     /// Role and layer settings of a patch: the last matching `[[patch]]` rule wins.
     pub fn patch_settings(&self, patch_name: &str) -> (Role, LayerSettings) {
         let mut role = Role::Wall;

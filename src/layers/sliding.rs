@@ -1,0 +1,292 @@
+//! Closing the layers against the patches their columns slid on (symmetry planes, inlets,
+//! outlets; see [`crate::normals::constraint`]).
+//!
+//! The layer cells at such a patch have faces lying in its plane that no other cell shares:
+//! they become boundary faces of the patch. The patch's own triangles are then partly under
+//! those faces, so the rest of the patch is triangulated anew (a constrained Delaunay
+//! triangulation in the plane, bounded by the layers' top edges and the patch's uncovered
+//! edges, through the patch's interior vertices that keep a clearance from that boundary), and
+//! the core meets these triangles instead of the original ones.
+
+use std::collections::{HashMap, HashSet};
+
+use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
+
+use crate::geometry::DVec3;
+use crate::mesh::VolumeMesh;
+use crate::normals::constraint::Plane;
+use crate::surface::Surface;
+
+/// A free face lies on a plane when its nodes are this close to it (fraction of body size).
+const ON_PLANE: f64 = 1e-9;
+/// Interior patch vertices closer to the new boundary than this fraction of the nearest
+/// boundary edge's length are left out of the new triangulation (they would make slivers).
+const CLEARANCE: f64 = 0.5;
+/// A bound on the points the refinement of a patch may add, per boundary edge.
+const MAX_ADDED_PER_EDGE: usize = 50;
+
+#[derive(Debug, thiserror::Error)]
+pub enum SlidingError {
+    #[error("a layer face {nodes:?} at {centre:?} has no neighbour and lies on no patch plane")]
+    StrayFace { nodes: Vec<u32>, centre: [f64; 3] },
+    #[error("patch {patch}: {why}")]
+    Retriangulation { patch: String, why: String },
+}
+
+/// Add the layer faces lying on the patch planes to the mesh's boundary and return the wall
+/// as the core must meet it: the input wall's triangles with every patch that layer faces
+/// cover re-triangulated around them; its points are all the mesh's points (the mesh starts
+/// with the wall's, so [`crate::fill::fill_core`] accepts it). Without such faces, the wall
+/// itself.
+pub fn close_sliding_patches(
+    mesh: &mut VolumeMesh,
+    wall: &Surface,
+    planes: &[Option<Plane>],
+) -> Result<Surface, SlidingError> {
+    let free = free_faces(mesh);
+    if free.is_empty() {
+        return Ok(wall.clone());
+    }
+    let tolerance = ON_PLANE * wall.bounding_box().diagonal();
+    let mut on_patch: Vec<Vec<Vec<u32>>> = vec![Vec::new(); wall.patch_names.len()];
+    for face in free {
+        let p = patch_of_face(&mesh.points, &face, planes, tolerance).ok_or_else(|| {
+            let centre = face.iter().map(|&n| mesh.points[n as usize]).sum::<DVec3>() / face.len() as f64;
+            SlidingError::StrayFace { nodes: face.clone(), centre: centre.to_array() }
+        })?;
+        match face[..] {
+            [a, b, c] => {
+                mesh.boundary.triangles.push([a, b, c]);
+                mesh.boundary.triangle_patch.push(p as u32);
+            }
+            [a, b, c, d] => {
+                mesh.boundary.quads.push([a, b, c, d]);
+                mesh.boundary.quad_patch.push(p as u32);
+            }
+            _ => {}
+        }
+        on_patch[p].push(face);
+    }
+    let mut core_wall = Surface { patch_names: wall.patch_names.clone(), ..Default::default() };
+    for (t, &tri) in wall.triangles.iter().enumerate() {
+        let p = wall.triangle_patch[t];
+        if on_patch[p as usize].is_empty() {
+            core_wall.triangles.push(tri);
+            core_wall.triangle_patch.push(p);
+        }
+    }
+    for (p, faces) in on_patch.iter().enumerate() {
+        let Some(plane) = planes.get(p).copied().flatten().filter(|_| !faces.is_empty()) else { continue };
+        let triangles = retriangulate(&mut mesh.points, wall, p as u32, faces, &plane).map_err(|why| {
+            SlidingError::Retriangulation { patch: wall.patch_names[p].clone(), why }
+        })?;
+        core_wall.triangle_patch.extend(std::iter::repeat_n(p as u32, triangles.len()));
+        core_wall.triangles.extend(triangles);
+    }
+    core_wall.points = mesh.points.clone();
+    Ok(core_wall)
+}
+
+/// Faces of exactly one cell that are not boundary faces of the mesh, oriented out of it.
+fn free_faces(mesh: &VolumeMesh) -> Vec<Vec<u32>> {
+    let key = |f: &[u32]| {
+        let mut k = f.to_vec();
+        k.sort_unstable();
+        k
+    };
+    let mut uses: HashMap<Vec<u32>, (u32, Vec<u32>)> = HashMap::new();
+    for (kind, cell) in mesh.cells() {
+        for local in kind.faces() {
+            let face: Vec<u32> = local.iter().map(|&i| cell[i]).collect();
+            uses.entry(key(&face)).or_insert((0, face)).0 += 1;
+        }
+    }
+    let listed: HashSet<Vec<u32>> = (mesh.boundary.triangles.iter().map(|t| key(t)))
+        .chain(mesh.boundary.quads.iter().map(|q| key(q)))
+        .collect();
+    let mut free: Vec<Vec<u32>> =
+        uses.into_iter().filter(|(k, (n, _))| *n == 1 && !listed.contains(k)).map(|(_, (_, f))| f).collect();
+    free.sort_unstable();
+    free
+}
+
+/// The patch whose plane holds every node of `face`.
+fn patch_of_face(points: &[DVec3], face: &[u32], planes: &[Option<Plane>], tolerance: f64) -> Option<usize> {
+    planes.iter().position(|plane| {
+        plane.is_some_and(|plane| {
+            face.iter().all(|&n| plane.signed_distance(points[n as usize]).abs() <= tolerance)
+        })
+    })
+}
+
+/// Undirected edge key.
+fn edge(a: u32, b: u32) -> (u32, u32) {
+    (a.min(b), a.max(b))
+}
+
+/// The new triangles of patch `p` (oriented like its own), covering what `covered` leaves;
+/// the points added inside are appended to `points`.
+fn retriangulate(
+    points: &mut Vec<DVec3>,
+    wall: &Surface,
+    p: u32,
+    covered: &[Vec<u32>],
+    plane: &Plane,
+) -> Result<Vec<[u32; 3]>, String> {
+    // The region's boundary: the patch's border edges and the covering faces' edges, each
+    // edge met twice cancelling (a border edge under a layer face, an edge between two faces).
+    let patch: Vec<[u32; 3]> =
+        (0..wall.triangles.len()).filter(|&t| wall.triangle_patch[t] == p).map(|t| wall.triangles[t]).collect();
+    let mut count: HashMap<(u32, u32), u32> = HashMap::new();
+    for t in &patch {
+        for i in 0..3 {
+            *count.entry(edge(t[i], t[(i + 1) % 3])).or_default() += 1;
+        }
+    }
+    let border: HashSet<(u32, u32)> = count.iter().filter(|(_, &n)| n == 1).map(|(&e, _)| e).collect();
+    let mut boundary: HashMap<(u32, u32), u32> = border.iter().map(|&e| (e, 1)).collect();
+    for face in covered {
+        for i in 0..face.len() {
+            *boundary.entry(edge(face[i], face[(i + 1) % face.len()])).or_default() += 1;
+        }
+    }
+    let boundary: Vec<(u32, u32)> = boundary.into_iter().filter(|(_, n)| n % 2 == 1).map(|(e, _)| e).collect();
+    let on_border: HashSet<u32> = border.iter().flat_map(|&(a, b)| [a, b]).collect();
+    let (u, v) = plane.frame();
+    let flat = |x: DVec3| Point2::new((x - plane.origin).dot(u), (x - plane.origin).dot(v));
+    let mut interior: Vec<u32> = patch.iter().flatten().copied().filter(|n| !on_border.contains(n)).collect();
+    interior.sort_unstable();
+    interior.dedup();
+    interior.retain(|&n| clear_of(points[n as usize], &boundary, points));
+    let patch_area: f64 = patch.iter().map(|t| triangle_area(points, *t)).sum();
+    let mut nodes: Vec<u32> = boundary.iter().flat_map(|&(a, b)| [a, b]).chain(interior).collect();
+    nodes.sort_unstable();
+    nodes.dedup();
+    let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> = ConstrainedDelaunayTriangulation::new();
+    let mut handle_node: HashMap<usize, u32> = HashMap::new();
+    let mut node_handle: HashMap<u32, spade::handles::FixedVertexHandle> = HashMap::new();
+    for &n in &nodes {
+        let h = cdt.insert(flat(points[n as usize])).map_err(|e| format!("node {n} at {:?}: {e:?}", points[n as usize]))?;
+        if let Some(other) = handle_node.insert(h.index(), n) {
+            return Err(format!("nodes {other} and {n} coincide at {:?}", points[n as usize]));
+        }
+        node_handle.insert(n, h);
+    }
+    for &(a, b) in &boundary {
+        let (ha, hb) = (node_handle[&a], node_handle[&b]);
+        if !cdt.can_add_constraint(ha, hb) {
+            return Err(format!(
+                "the boundary edge {a}-{b} at {:?} crosses another one (the layers fold on the patch)",
+                points[a as usize]
+            ));
+        }
+        cdt.add_constraint(ha, hb);
+    }
+    refine(&mut cdt, &boundary, points, patch_area / patch.len().max(1) as f64);
+    let added: Vec<_> = cdt.fixed_vertices().filter(|h| !handle_node.contains_key(&h.index())).collect();
+    for h in added {
+        let x = cdt.vertex(h).position();
+        handle_node.insert(h.index(), points.len() as u32);
+        points.push(plane.project(plane.origin + u * x.x + v * x.y));
+    }
+    let inside = inside_faces(&cdt);
+    let mut triangles = Vec::new();
+    for face in cdt.inner_faces() {
+        if !inside[face.fix().index()] {
+            continue;
+        }
+        let [a, b, c] = face.vertices().map(|h| handle_node[&h.fix().index()]);
+        triangles.push([a, b, c]);
+    }
+    check_covers(&triangles, &boundary, points, plane)?;
+    Ok(triangles)
+}
+
+/// Add points inside the region until its triangles have no angle below 25 degrees and are no
+/// larger than `mean_area` (the patch's original mean) or an equilateral triangle on the mean
+/// boundary edge, whichever is larger; the boundary edges are kept.
+fn refine(
+    cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
+    boundary: &[(u32, u32)],
+    points: &[DVec3],
+    mean_area: f64,
+) {
+    let lengths = boundary.iter().map(|&(a, b)| (points[a as usize] - points[b as usize]).length());
+    let mean_edge = lengths.sum::<f64>() / boundary.len().max(1) as f64;
+    let max_area = mean_area.max(0.25 * 3f64.sqrt() * mean_edge * mean_edge);
+    let parameters = RefinementParameters::<f64>::new()
+        .exclude_outer_faces(true)
+        .keep_constraint_edges()
+        .with_angle_limit(AngleLimit::from_deg(25.0))
+        .with_max_allowed_area(max_area)
+        .with_max_additional_vertices(MAX_ADDED_PER_EDGE * boundary.len() + 1000);
+    cdt.refine(parameters);
+}
+
+fn triangle_area(points: &[DVec3], [a, b, c]: [u32; 3]) -> f64 {
+    crate::geometry::triangle_area_vector(points[a as usize], points[b as usize], points[c as usize]).length()
+}
+
+/// Is `x` at least [`CLEARANCE`] edge lengths away from every boundary edge?
+fn clear_of(x: DVec3, boundary: &[(u32, u32)], points: &[DVec3]) -> bool {
+    boundary.iter().all(|&(a, b)| {
+        let (a, b) = (points[a as usize], points[b as usize]);
+        let length = (b - a).length();
+        let t = ((x - a).dot(b - a) / (length * length)).clamp(0.0, 1.0);
+        (a + (b - a) * t - x).length() >= CLEARANCE * length
+    })
+}
+
+/// Faces of the triangulation inside the constraint edges (an odd number of them crossed on
+/// the way from the outer face), by face index.
+fn inside_faces(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<bool> {
+    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
+    let outer = cdt.outer_face();
+    parity[outer.fix().index()] = Some(false);
+    let mut stack = vec![(outer.fix(), false)];
+    while let Some((face, inside)) = stack.pop() {
+        // Each edge of the face, with the face across it.
+        let edges: Vec<_> = match cdt.face(face).as_inner() {
+            Some(inner) => inner.adjacent_edges().iter().map(|e| (*e, e.rev().face().fix())).collect(),
+            None => cdt
+                .convex_hull()
+                .map(|e| {
+                    let across = if e.face().is_outer() { e.rev().face() } else { e.face() };
+                    (e, across.fix())
+                })
+                .collect(),
+        };
+        for (e, across) in edges {
+            if parity[across.index()].is_some() {
+                continue;
+            }
+            let flips = cdt.is_constraint_edge(e.as_undirected().fix());
+            parity[across.index()] = Some(inside != flips);
+            stack.push((across, inside != flips));
+        }
+    }
+    parity.into_iter().map(|p| p.unwrap_or(false)).collect()
+}
+
+/// The new triangles must face like the plane and use every boundary edge once.
+fn check_covers(
+    triangles: &[[u32; 3]],
+    boundary: &[(u32, u32)],
+    points: &[DVec3],
+    plane: &Plane,
+) -> Result<(), String> {
+    let mut used: HashMap<(u32, u32), u32> = HashMap::new();
+    for &[a, b, c] in triangles {
+        let [x, y, z] = [a, b, c].map(|n| points[n as usize]);
+        if crate::geometry::triangle_area_vector(x, y, z).dot(plane.normal) <= 0.0 {
+            return Err(format!("the new triangle {:?} at {:?} is flat or reversed", [a, b, c], x));
+        }
+        for (p, q) in [(a, b), (b, c), (c, a)] {
+            *used.entry(edge(p, q)).or_default() += 1;
+        }
+    }
+    match boundary.iter().find(|e| used.get(e) != Some(&1)) {
+        Some(&(a, b)) => Err(format!("the boundary edge {a}-{b} at {:?} is not closed off", points[a as usize])),
+        None => Ok(()),
+    }
+}
