@@ -143,7 +143,8 @@ pub fn run(
     });
     let wall_normals = timings.time("normals", || {
         let fan_angle = config.fan_angle();
-        let mut n = normals::wall_normals_of_layered(&surface, &topology, &features, fan_angle, &layered_patch);
+        let mut n =
+            normals::wall_normals_of_layered(&surface, &topology, &features, fan_angle, &layered_patch);
         n.slides = constraint::constrain_columns(&surface, &mut n, &layered_patch, &planes);
         n
     });
@@ -160,8 +161,8 @@ pub fn run(
     let core_wall = core_wall?;
     let layer_summary = layer_summary(&layered, &surface, &features);
     let (mesh, core) = if options.core {
-        let (mesh, stats) =
-            timings.time("core", || fill_core(&layered.mesh, &core_wall, &CoreOptions::from_config(config)))?;
+        let (mesh, stats) = timings
+            .time("core", || fill_core(&layered.mesh, &core_wall, &CoreOptions::from_config(config)))?;
         (mesh, Some(stats))
     } else {
         (std::mem::take(&mut layered.mesh), None)

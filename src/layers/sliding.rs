@@ -77,9 +77,8 @@ pub fn close_sliding_patches(
     }
     for (p, faces) in on_patch.iter().enumerate() {
         let Some(plane) = planes.get(p).copied().flatten().filter(|_| !faces.is_empty()) else { continue };
-        let triangles = retriangulate(&mut mesh.points, wall, p as u32, faces, &plane).map_err(|why| {
-            SlidingError::Retriangulation { patch: wall.patch_names[p].clone(), why }
-        })?;
+        let triangles = retriangulate(&mut mesh.points, wall, p as u32, faces, &plane)
+            .map_err(|why| SlidingError::Retriangulation { patch: wall.patch_names[p].clone(), why })?;
         core_wall.triangle_patch.extend(std::iter::repeat_n(p as u32, triangles.len()));
         core_wall.triangles.extend(triangles);
     }
@@ -135,8 +134,10 @@ fn retriangulate(
 ) -> Result<Vec<[u32; 3]>, String> {
     // The region's boundary: the patch's border edges and the covering faces' edges, each
     // edge met twice cancelling (a border edge under a layer face, an edge between two faces).
-    let patch: Vec<[u32; 3]> =
-        (0..wall.triangles.len()).filter(|&t| wall.triangle_patch[t] == p).map(|t| wall.triangles[t]).collect();
+    let patch: Vec<[u32; 3]> = (0..wall.triangles.len())
+        .filter(|&t| wall.triangle_patch[t] == p)
+        .map(|t| wall.triangles[t])
+        .collect();
     let mut count: HashMap<(u32, u32), u32> = HashMap::new();
     for t in &patch {
         for i in 0..3 {
@@ -150,7 +151,8 @@ fn retriangulate(
             *boundary.entry(edge(face[i], face[(i + 1) % face.len()])).or_default() += 1;
         }
     }
-    let boundary: Vec<(u32, u32)> = boundary.into_iter().filter(|(_, n)| n % 2 == 1).map(|(e, _)| e).collect();
+    let boundary: Vec<(u32, u32)> =
+        boundary.into_iter().filter(|(_, n)| n % 2 == 1).map(|(e, _)| e).collect();
     let on_border: HashSet<u32> = border.iter().flat_map(|&(a, b)| [a, b]).collect();
     let (u, v) = plane.frame();
     let flat = |x: DVec3| Point2::new((x - plane.origin).dot(u), (x - plane.origin).dot(v));
@@ -166,7 +168,9 @@ fn retriangulate(
     let mut handle_node: HashMap<usize, u32> = HashMap::new();
     let mut node_handle: HashMap<u32, spade::handles::FixedVertexHandle> = HashMap::new();
     for &n in &nodes {
-        let h = cdt.insert(flat(points[n as usize])).map_err(|e| format!("node {n} at {:?}: {e:?}", points[n as usize]))?;
+        let h = cdt
+            .insert(flat(points[n as usize]))
+            .map_err(|e| format!("node {n} at {:?}: {e:?}", points[n as usize]))?;
         if let Some(other) = handle_node.insert(h.index(), n) {
             return Err(format!("nodes {other} and {n} coincide at {:?}", points[n as usize]));
         }
@@ -286,7 +290,9 @@ fn check_covers(
         }
     }
     match boundary.iter().find(|e| used.get(e) != Some(&1)) {
-        Some(&(a, b)) => Err(format!("the boundary edge {a}-{b} at {:?} is not closed off", points[a as usize])),
+        Some(&(a, b)) => {
+            Err(format!("the boundary edge {a}-{b} at {:?} is not closed off", points[a as usize]))
+        }
         None => Ok(()),
     }
 }

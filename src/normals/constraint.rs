@@ -95,7 +95,8 @@ pub fn snap_planar_patches(surface: &mut Surface, layered_patch: &[bool]) -> Vec
                 return None;
             }
             fit_plane(surface, p as u32).filter(|plane| {
-                patch_vertices(surface, p as u32).all(|v| plane.signed_distance(surface.points[v]).abs() <= tolerance)
+                patch_vertices(surface, p as u32)
+                    .all(|v| plane.signed_distance(surface.points[v]).abs() <= tolerance)
             })
         })
         .collect();

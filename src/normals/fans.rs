@@ -126,9 +126,8 @@ pub fn wall_normals_of_layered(
     let layered =
         |t: u32| layered_patch.get(surface.triangle_patch[t as usize] as usize).copied().unwrap_or(true);
     let uses_layered = |e: u32| topology.edge_uses(e).iter().map(|u| layered(u.triangle));
-    let is_fan_edge = |e: u32| {
-        features.edge_kind[e as usize] == EdgeKind::ConvexRidge && uses_layered(e).all(|l| l)
-    };
+    let is_fan_edge =
+        |e: u32| features.edge_kind[e as usize] == EdgeKind::ConvexRidge && uses_layered(e).all(|l| l);
     // Sectors also end where the layered triangles end.
     let is_cut = |e: u32| is_fan_edge(e) || (uses_layered(e).any(|l| l) && uses_layered(e).any(|l| !l));
     // Per (vertex, fan edge): the sector columns on the edge's t1 side (index 0) and t2 side.
