@@ -4,7 +4,7 @@
 use serde::Serialize;
 
 use crate::config::{Config, ConfigError, Flow, LayerCount, LayerSpec};
-use crate::fill::{fill_core, CoreOptions, CoreStats, FillError};
+use crate::fill::{fill_core_on_symmetry_plane, CoreOptions, CoreStats, FillError};
 use crate::layers::sliding::SlidingError;
 use crate::layers::{self, MarchStats};
 use crate::mesh::{CellKind, VolumeMesh};
@@ -158,11 +158,25 @@ pub fn run(
         (layered, core_wall)
     });
     bar.finish_and_clear();
-    let core_wall = core_wall?;
+    let closed = core_wall?;
+    let symmetry = match closed.symmetry.as_slice() {
+        [] => None,
+        [one] => Some(one),
+        [_, more @ ..] => {
+            let names: Vec<&str> =
+                more.iter().map(|s| surface.patch_names[s.patch as usize].as_str()).collect();
+            return Err(MeshError::Unsupported(format!(
+                "more than one symmetry plane with the body on it (also {names:?}): the farfield can \
+                 be cut by one only"
+            )));
+        }
+    };
     let layer_summary = layer_summary(&layered, &surface, &features);
     let (mesh, core) = if options.core {
-        let (mesh, stats) = timings
-            .time("core", || fill_core(&layered.mesh, &core_wall, &CoreOptions::from_config(config)))?;
+        let (mesh, stats) = timings.time("core", || {
+            let options = CoreOptions::from_config(config);
+            fill_core_on_symmetry_plane(&layered.mesh, &closed.core_wall, &options, symmetry)
+        })?;
         (mesh, Some(stats))
     } else {
         (std::mem::take(&mut layered.mesh), None)

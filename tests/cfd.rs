@@ -117,3 +117,24 @@ fn a_box_with_a_symmetry_face_keeps_its_layers_on_the_plane_with_full_coverage()
         assert!(patch_quads(m, "zmin") >= 8 * 4 * 4 - 8, "core {core}: {} quads", patch_quads(m, "zmin"));
     }
 }
+
+/// A box standing on a symmetry plane in an external flow: the farfield is a half box whose
+/// face on the plane is triangulated around the layers sliding on it.
+#[test]
+fn a_box_on_a_symmetry_plane_meshes_in_a_half_box() {
+    let surface = shapes::cuboid(DVec3::new(2.0, 1.0, 0.5), 4);
+    let size = surface.bounding_box().diagonal();
+    let config =
+        "[layers]\ncount = 8\nfirst_height = 1e-3\n[[patch]]\nmatch = \"zmin\"\nrole = \"symmetry\"\n";
+    let out = mesh(&surface, config, true);
+    let m = &out.mesh;
+    let nodes = patch_nodes(m, "zmin");
+    assert!(off_plane(m, &nodes, 2, 0.0) <= 1e-12 * size);
+    assert!(m.points.iter().all(|p| p.z >= 0.0), "nothing below the symmetry plane");
+    assert_eq!(out.report.layers.full_coverage, 1.0);
+    // The symmetry patch: the layer faces on the plane and the plane around them, out to the
+    // farfield (much larger than the box's footprint).
+    let extent = nodes.iter().map(|&n| m.points[n as usize].x).fold(0.0, f64::max);
+    assert!(extent > 5.0 * size, "the symmetry face reaches the farfield ({extent})");
+    assert!(patch_quads(m, "zmin") >= 8 * 4 * 4);
+}

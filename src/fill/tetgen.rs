@@ -278,7 +278,7 @@ mod tests {
     #[test]
     fn switches_keep_the_boundary_and_bound_the_quality() {
         let s = TetGen::default().switches(true);
-        assert!(s.starts_with("pYMzQq1.4000/18.0000O9/7"), "{s}");
+        assert!(s.starts_with("pYMzQq1.4000/18.0000O4/7"), "{s}");
         assert!(s.ends_with('m'));
         assert!(!TetGen::default().switches(false).contains('m'));
     }

@@ -35,17 +35,18 @@ pub enum SlidingError {
 
 /// Add the layer faces lying on the patch planes to the mesh's boundary and return the wall
 /// as the core must meet it: the input wall's triangles with every patch that layer faces
-/// cover re-triangulated around them; its points are all the mesh's points (the mesh starts
-/// with the wall's, so [`crate::fill::fill_core`] accepts it). Without such faces, the wall
-/// itself.
+/// cover re-triangulated around them, and without the patches the layers slid away from
+/// (symmetry planes of an external flow, returned apart); its points are all the mesh's
+/// points (the mesh starts with the wall's, so [`crate::fill::fill_core`] accepts it).
+/// Without such faces, the wall itself.
 pub fn close_sliding_patches(
     mesh: &mut VolumeMesh,
     wall: &Surface,
     planes: &[Option<Plane>],
-) -> Result<Surface, SlidingError> {
+) -> Result<Closed, SlidingError> {
     let free = free_faces(mesh);
     if free.is_empty() {
-        return Ok(wall.clone());
+        return Ok(Closed { core_wall: wall.clone(), symmetry: Vec::new() });
     }
     let tolerance = ON_PLANE * wall.bounding_box().diagonal();
     let mut on_patch: Vec<Vec<Vec<u32>>> = vec![Vec::new(); wall.patch_names.len()];
@@ -75,15 +76,52 @@ pub fn close_sliding_patches(
             core_wall.triangle_patch.push(p);
         }
     }
+    let mut symmetry = Vec::new();
     for (p, faces) in on_patch.iter().enumerate() {
         let Some(plane) = planes.get(p).copied().flatten().filter(|_| !faces.is_empty()) else { continue };
+        if is_cap(&mesh.points, faces, &plane) {
+            // The fluid is on the other side of the patch's plane; the patch is not a boundary.
+            symmetry.push(SymmetryPlane { patch: p as u32, plane: Plane { normal: -plane.normal, ..plane } });
+            continue;
+        }
         let triangles = retriangulate(&mut mesh.points, wall, p as u32, faces, &plane)
             .map_err(|why| SlidingError::Retriangulation { patch: wall.patch_names[p].clone(), why })?;
         core_wall.triangle_patch.extend(std::iter::repeat_n(p as u32, triangles.len()));
         core_wall.triangles.extend(triangles);
     }
     core_wall.points = mesh.points.clone();
-    Ok(core_wall)
+    Ok(Closed { core_wall, symmetry })
+}
+
+/// The wall the core meets, and the symmetry planes that need a farfield.
+pub struct Closed {
+    pub core_wall: Surface,
+    /// Patches whose layer faces lie outside them (a body cut by its symmetry plane, with the
+    /// fluid on the other side of its cut face): the core is bounded there by the rest of the
+    /// plane, which the farfield must supply.
+    pub symmetry: Vec<SymmetryPlane>,
+}
+
+/// A symmetry plane of an external flow: the plane of `patch`, its normal into the fluid.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct SymmetryPlane {
+    pub patch: u32,
+    pub plane: Plane,
+}
+
+/// Do the layer faces on the patch face the way its triangles do? Then they lie outside it:
+/// the layers slid away from the patch (a convex junction), not over it.
+fn is_cap(points: &[DVec3], faces: &[Vec<u32>], plane: &Plane) -> bool {
+    let area: DVec3 = faces
+        .iter()
+        .map(|f| {
+            let x: Vec<DVec3> = f.iter().map(|&n| points[n as usize]).collect();
+            (1..x.len() - 1)
+                .map(|i| crate::geometry::triangle_area_vector(x[0], x[i], x[i + 1]))
+                .sum::<DVec3>()
+        })
+        .sum();
+    area.dot(plane.normal) > 0.0
 }
 
 /// Faces of exactly one cell that are not boundary faces of the mesh, oriented out of it.
@@ -154,14 +192,30 @@ fn retriangulate(
     let boundary: Vec<(u32, u32)> =
         boundary.into_iter().filter(|(_, n)| n % 2 == 1).map(|(e, _)| e).collect();
     let on_border: HashSet<u32> = border.iter().flat_map(|&(a, b)| [a, b]).collect();
-    let (u, v) = plane.frame();
-    let flat = |x: DVec3| Point2::new((x - plane.origin).dot(u), (x - plane.origin).dot(v));
     let mut interior: Vec<u32> = patch.iter().flatten().copied().filter(|n| !on_border.contains(n)).collect();
     interior.sort_unstable();
     interior.dedup();
     interior.retain(|&n| clear_of(points[n as usize], &boundary, points));
     let patch_area: f64 = patch.iter().map(|t| triangle_area(points, *t)).sum();
-    let mut nodes: Vec<u32> = boundary.iter().flat_map(|&(a, b)| [a, b]).chain(interior).collect();
+    triangulate_region(points, &boundary, &interior, plane, patch_area / patch.len().max(1) as f64)
+}
+
+/// A constrained Delaunay triangulation of the region of `plane` that `boundary` (node pairs,
+/// closed loops; holes allowed) encloses, through the `interior` nodes, refined until no angle
+/// is below 25 degrees and no triangle larger than `max_area` or an equilateral triangle on
+/// the mean boundary edge (the boundary edges are kept). Added points are appended to
+/// `points`, on the plane. The triangles face like `plane.normal`.
+pub fn triangulate_region(
+    points: &mut Vec<DVec3>,
+    boundary: &[(u32, u32)],
+    interior: &[u32],
+    plane: &Plane,
+    max_area: f64,
+) -> Result<Vec<[u32; 3]>, String> {
+    let (u, v) = plane.frame();
+    let flat = |x: DVec3| Point2::new((x - plane.origin).dot(u), (x - plane.origin).dot(v));
+    let mut nodes: Vec<u32> =
+        boundary.iter().flat_map(|&(a, b)| [a, b]).chain(interior.iter().copied()).collect();
     nodes.sort_unstable();
     nodes.dedup();
     let mut cdt: ConstrainedDelaunayTriangulation<Point2<f64>> = ConstrainedDelaunayTriangulation::new();
@@ -176,7 +230,7 @@ fn retriangulate(
         }
         node_handle.insert(n, h);
     }
-    for &(a, b) in &boundary {
+    for &(a, b) in boundary {
         let (ha, hb) = (node_handle[&a], node_handle[&b]);
         if !cdt.can_add_constraint(ha, hb) {
             return Err(format!(
@@ -186,7 +240,7 @@ fn retriangulate(
         }
         cdt.add_constraint(ha, hb);
     }
-    refine(&mut cdt, &boundary, points, patch_area / patch.len().max(1) as f64);
+    refine(&mut cdt, boundary, points, max_area);
     let added: Vec<_> = cdt.fixed_vertices().filter(|h| !handle_node.contains_key(&h.index())).collect();
     for h in added {
         let x = cdt.vertex(h).position();
@@ -202,13 +256,11 @@ fn retriangulate(
         let [a, b, c] = face.vertices().map(|h| handle_node[&h.fix().index()]);
         triangles.push([a, b, c]);
     }
-    check_covers(&triangles, &boundary, points, plane)?;
+    check_covers(&triangles, boundary, points, plane)?;
     Ok(triangles)
 }
 
-/// Add points inside the region until its triangles have no angle below 25 degrees and are no
-/// larger than `mean_area` (the patch's original mean) or an equilateral triangle on the mean
-/// boundary edge, whichever is larger; the boundary edges are kept.
+/// Add points inside the region (see [`triangulate_region`]).
 fn refine(
     cdt: &mut ConstrainedDelaunayTriangulation<Point2<f64>>,
     boundary: &[(u32, u32)],
