@@ -138,3 +138,41 @@ fn a_box_on_a_symmetry_plane_meshes_in_a_half_box() {
     assert!(extent > 5.0 * size, "the symmetry face reaches the farfield ({extent})");
     assert!(patch_quads(m, "zmin") >= 8 * 4 * 4);
 }
+
+const ONERA_M6: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/onera_m6_gmsh_coarse.stl");
+
+/// The ONERA M6 half wing on its symmetry plane (root face `face9`, y = 0), 25 layers from
+/// y+ = 1 at Re = 14.6e6 on the mean aerodynamic chord (mm): the issue's set-up.
+#[test]
+fn onera_m6_half_wing_on_its_symmetry_plane() {
+    let surface = read_surface(std::path::Path::new(ONERA_M6)).expect("the wing reads");
+    let span = surface.bounding_box().max.y - surface.bounding_box().min.y;
+    let config = "[layers]\nyplus = 1.0\ncount = 25\ngrowth = 1.2\n\
+                  [flow_conditions]\nreynolds = 14.6e6\nlength = 646.07\n\
+                  [[patch]]\nmatch = \"face9\"\nrole = \"symmetry\"\n";
+    let out = mesh(&surface, config, true);
+    let m = &out.mesh;
+    let nodes = patch_nodes(m, "face9");
+    assert!(off_plane(m, &nodes, 1, 0.0) <= 1e-12 * span, "symmetry nodes off the plane y = 0");
+    assert!(m.points.iter().all(|p| p.y >= 0.0), "nothing on the mirror side");
+    let layers = &out.report.layers;
+    assert!(layers.full_coverage > 0.99, "coverage {}", layers.full_coverage);
+    // The columns that stop early are at the wing tip, none at the root junction.
+    assert!(layers.stopped_examples.iter().all(|p| p[1] > 0.5 * span), "{:?}", layers.stopped_examples);
+    // Every root vertex slid along the plane with its full stack: 25 layer faces on the plane
+    // per border edge of the root face.
+    let root_edges = input_patch_border_edges(&surface, "face9");
+    assert!(patch_quads(m, "face9") >= 25 * (root_edges - 4), "{} layer faces", patch_quads(m, "face9"));
+}
+
+/// Border edges of patch `name` (edges used once by its triangles).
+fn input_patch_border_edges(s: &Surface, name: &str) -> usize {
+    let mut count = std::collections::HashMap::new();
+    for t in input_patch_triangles(s, name) {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            *count.entry((a.min(b), a.max(b))).or_insert(0) += 1;
+        }
+    }
+    count.values().filter(|&&n| n == 1).count()
+}
