@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use crate::config::{Config, ConfigError, Flow, LayerCount, LayerSpec};
+use crate::config::{Config, ConfigError, Flow, LayerCount, LayerSpec, Role};
 use crate::fill::{fill_core_on_symmetry_plane, CoreOptions, CoreStats, FillError};
 use crate::layers::sliding::SlidingError;
 use crate::layers::{self, MarchStats};
@@ -132,6 +132,8 @@ pub fn run(
     }));
     let patch_spec = patch_layer_specs(&surface, config, body_size)?;
     let layered_patch: Vec<bool> = patch_spec.iter().map(Option::is_some).collect();
+    let symmetry_patch: Vec<bool> =
+        surface.patch_names.iter().map(|name| config.patch_settings(name).0 == Role::Symmetry).collect();
     // Columns slide on the planar patches without layers, whose vertices are snapped onto
     // their planes first.
     let planes = constraint::snap_planar_patches(&mut surface, &layered_patch);
@@ -154,7 +156,8 @@ pub fn run(
             bar.set_length(n as u64);
             bar.set_position(k as u64);
         });
-        let core_wall = layers::sliding::close_sliding_patches(&mut layered.mesh, &surface, &planes);
+        let core_wall =
+            layers::sliding::close_sliding_patches(&mut layered.mesh, &surface, &planes, &symmetry_patch);
         (layered, core_wall)
     });
     bar.finish_and_clear();

@@ -35,14 +35,17 @@ pub enum SlidingError {
 
 /// Add the layer faces lying on the patch planes to the mesh's boundary and return the wall
 /// as the core must meet it: the input wall's triangles with every patch that layer faces
-/// cover re-triangulated around them, and without the patches the layers slid away from
-/// (symmetry planes of an external flow, returned apart); its points are all the mesh's
-/// points (the mesh starts with the wall's, so [`crate::fill::fill_core`] accepts it).
+/// cover re-triangulated around them, and without the symmetry patches (`symmetry_patch[p]`)
+/// the layers slid away from (a body's cut face in an external flow: returned apart, the
+/// farfield closes the plane); its points are all the mesh's points (the mesh starts with the
+/// wall's, so [`crate::fill::fill_core`] accepts it). The layer faces that slid off the edge
+/// of any other patch join the top of the layers ([`super::TOP_PATCH`]): the core meets them.
 /// Without such faces, the wall itself.
 pub fn close_sliding_patches(
     mesh: &mut VolumeMesh,
     wall: &Surface,
     planes: &[Option<Plane>],
+    symmetry_patch: &[bool],
 ) -> Result<Closed, SlidingError> {
     let free = free_faces(mesh);
     if free.is_empty() {
@@ -55,42 +58,66 @@ pub fn close_sliding_patches(
             let centre = face.iter().map(|&n| mesh.points[n as usize]).sum::<DVec3>() / face.len() as f64;
             SlidingError::StrayFace { nodes: face.clone(), centre: centre.to_array() }
         })?;
-        match face[..] {
-            [a, b, c] => {
-                mesh.boundary.triangles.push([a, b, c]);
-                mesh.boundary.triangle_patch.push(p as u32);
-            }
-            [a, b, c, d] => {
-                mesh.boundary.quads.push([a, b, c, d]);
-                mesh.boundary.quad_patch.push(p as u32);
-            }
-            _ => {}
-        }
         on_patch[p].push(face);
     }
-    let mut core_wall = Surface { patch_names: wall.patch_names.clone(), ..Default::default() };
-    for (t, &tri) in wall.triangles.iter().enumerate() {
-        let p = wall.triangle_patch[t];
-        if on_patch[p as usize].is_empty() {
-            core_wall.triangles.push(tri);
-            core_wall.triangle_patch.push(p);
-        }
+    let top = mesh.patch_names.iter().position(|n| n == super::TOP_PATCH).unwrap_or(mesh.patch_names.len());
+    if top == mesh.patch_names.len() {
+        mesh.patch_names.push(super::TOP_PATCH.to_owned());
     }
+    // Patches whose own triangles the core still meets, and the triangles replacing the others.
+    let mut kept = vec![true; wall.patch_names.len()];
+    let mut new_triangles: Vec<(u32, [u32; 3])> = Vec::new();
     let mut symmetry = Vec::new();
     for (p, faces) in on_patch.iter().enumerate() {
         let Some(plane) = planes.get(p).copied().flatten().filter(|_| !faces.is_empty()) else { continue };
-        if is_cap(&mesh.points, faces, &plane) {
-            // The fluid is on the other side of the patch's plane; the patch is not a boundary.
+        let face_patch = if !is_cap(&mesh.points, faces, &plane) {
+            kept[p] = false;
+            let triangles = retriangulate(&mut mesh.points, wall, p as u32, faces, &plane)
+                .map_err(|why| SlidingError::Retriangulation { patch: wall.patch_names[p].clone(), why })?;
+            new_triangles.extend(triangles.into_iter().map(|t| (p as u32, t)));
+            p
+        } else if symmetry_patch.get(p).copied().unwrap_or(false) {
+            // A body cut by its symmetry plane: the fluid is across the cut face, which is no
+            // boundary; the rest of the plane is.
+            kept[p] = false;
             symmetry.push(SymmetryPlane { patch: p as u32, plane: Plane { normal: -plane.normal, ..plane } });
-            continue;
+            p
+        } else {
+            // Layers sliding off the edge of a patch the fluid sees: their faces there are
+            // front, which the core meets like the top of the layers.
+            top
+        };
+        for face in faces {
+            push_face(mesh, face, face_patch as u32);
         }
-        let triangles = retriangulate(&mut mesh.points, wall, p as u32, faces, &plane)
-            .map_err(|why| SlidingError::Retriangulation { patch: wall.patch_names[p].clone(), why })?;
-        core_wall.triangle_patch.extend(std::iter::repeat_n(p as u32, triangles.len()));
-        core_wall.triangles.extend(triangles);
+    }
+    let mut core_wall = Surface { patch_names: wall.patch_names.clone(), ..Default::default() };
+    for (t, &tri) in wall.triangles.iter().enumerate() {
+        if kept[wall.triangle_patch[t] as usize] {
+            core_wall.triangles.push(tri);
+            core_wall.triangle_patch.push(wall.triangle_patch[t]);
+        }
+    }
+    for (p, t) in new_triangles {
+        core_wall.triangles.push(t);
+        core_wall.triangle_patch.push(p);
     }
     core_wall.points = mesh.points.clone();
     Ok(Closed { core_wall, symmetry })
+}
+
+fn push_face(mesh: &mut VolumeMesh, face: &[u32], patch: u32) {
+    match *face {
+        [a, b, c] => {
+            mesh.boundary.triangles.push([a, b, c]);
+            mesh.boundary.triangle_patch.push(patch);
+        }
+        [a, b, c, d] => {
+            mesh.boundary.quads.push([a, b, c, d]);
+            mesh.boundary.quad_patch.push(patch);
+        }
+        _ => {}
+    }
 }
 
 /// The wall the core meets, and the symmetry planes that need a farfield.
@@ -126,23 +153,31 @@ fn is_cap(points: &[DVec3], faces: &[Vec<u32>], plane: &Plane) -> bool {
 
 /// Faces of exactly one cell that are not boundary faces of the mesh, oriented out of it.
 fn free_faces(mesh: &VolumeMesh) -> Vec<Vec<u32>> {
+    // A face's key: its sorted nodes, a triangle's padded with u32::MAX.
     let key = |f: &[u32]| {
-        let mut k = f.to_vec();
+        let mut k = [u32::MAX; 4];
+        k[..f.len()].copy_from_slice(f);
         k.sort_unstable();
         k
     };
-    let mut uses: HashMap<Vec<u32>, (u32, Vec<u32>)> = HashMap::new();
+    let mut uses: HashMap<[u32; 4], (u32, [u32; 4], usize)> = HashMap::new();
     for (kind, cell) in mesh.cells() {
         for local in kind.faces() {
-            let face: Vec<u32> = local.iter().map(|&i| cell[i]).collect();
-            uses.entry(key(&face)).or_insert((0, face)).0 += 1;
+            let mut face = [0; 4];
+            for (x, &i) in face.iter_mut().zip(local.iter()) {
+                *x = cell[i];
+            }
+            uses.entry(key(&face[..local.len()])).or_insert((0, face, local.len())).0 += 1;
         }
     }
-    let listed: HashSet<Vec<u32>> = (mesh.boundary.triangles.iter().map(|t| key(t)))
+    let listed: HashSet<[u32; 4]> = (mesh.boundary.triangles.iter().map(|t| key(t)))
         .chain(mesh.boundary.quads.iter().map(|q| key(q)))
         .collect();
-    let mut free: Vec<Vec<u32>> =
-        uses.into_iter().filter(|(k, (n, _))| *n == 1 && !listed.contains(k)).map(|(_, (_, f))| f).collect();
+    let mut free: Vec<Vec<u32>> = uses
+        .into_iter()
+        .filter(|(k, (n, _, _))| *n == 1 && !listed.contains(k))
+        .map(|(_, (_, f, len))| f[..len].to_vec())
+        .collect();
     free.sort_unstable();
     free
 }
@@ -346,5 +381,36 @@ fn check_covers(
             Err(format!("the boundary edge {a}-{b} at {:?} is not closed off", points[a as usize]))
         }
         None => Ok(()),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_square_with_a_square_hole_is_covered_once_facing_the_plane() {
+        let square = |h: f64| [(-h, -h), (h, -h), (h, h), (-h, h)].map(|(x, y)| DVec3::new(x, y, 0.0));
+        let mut points: Vec<DVec3> = square(2.0).into_iter().chain(square(0.5)).collect();
+        let boundary: Vec<(u32, u32)> =
+            (0..4).flat_map(|i| [(i, (i + 1) % 4), (4 + i, 4 + (i + 1) % 4)]).collect();
+        let plane = Plane { origin: DVec3::ZERO, normal: DVec3::Z };
+        let triangles = triangulate_region(&mut points, &boundary, &[], &plane, 0.5).unwrap();
+        let area: f64 = triangles.iter().map(|&t| triangle_area(&points, t)).sum::<f64>() / 2.0;
+        assert!((area - (16.0 - 1.0)).abs() < 1e-12, "area {area}");
+        assert!(points.len() > 8, "refined: {} points", points.len());
+        assert!(points.iter().all(|p| p.z == 0.0 && p.x.abs() <= 2.0 && p.y.abs() <= 2.0));
+        for t in &triangles {
+            assert!(!t.iter().all(|&n| n >= 4 && n < 8), "a triangle inside the hole: {t:?}");
+        }
+    }
+
+    #[test]
+    fn crossing_boundary_edges_are_an_error() {
+        let mut points: Vec<DVec3> =
+            [(0.0, 0.0), (1.0, 1.0), (1.0, 0.0), (0.0, 1.0)].map(|(x, y)| DVec3::new(x, y, 0.0)).to_vec();
+        let plane = Plane { origin: DVec3::ZERO, normal: DVec3::Z };
+        let e = triangulate_region(&mut points, &[(0, 1), (2, 3)], &[], &plane, 1.0).unwrap_err();
+        assert!(e.contains("crosses"), "{e}");
     }
 }

@@ -254,6 +254,36 @@ mod tests {
     }
 
     #[test]
+    fn columns_at_a_symmetry_face_slide_in_its_plane_and_its_ridges_get_no_fans() {
+        use crate::surface::features::Features;
+        use crate::surface::topology::Topology;
+        let mut s = cuboid(DVec3::ONE, 2);
+        let mut layered = vec![true; 6];
+        layered[4] = false; // zmin
+        let planes = snap_planar_patches(&mut s, &layered);
+        let topology = Topology::new(&s);
+        let features = Features::compute(&s, &topology, 30.0);
+        let mut n = super::super::wall_normals_of_layered(&s, &topology, &features, 20.0, &layered);
+        // 4 edges of 2 segments at the top, 4 vertical ones: none along the floor.
+        assert_eq!(n.stats.fan_edges, 16);
+        let slides = constrain_columns(&s, &mut n, &layered, &planes);
+        let zmin = planes[4].expect("planar");
+        let on_floor = |c: usize| s.points[n.columns[c].vertex as usize].z == 0.0;
+        let layered_column = |c: usize| {
+            let t = n.triangle_columns.iter().position(|cols| cols.contains(&(c as u32)));
+            t.is_none_or(|t| layered[s.triangle_patch[t] as usize])
+        };
+        let sliding: Vec<usize> =
+            (0..n.columns.len()).filter(|&c| on_floor(c) && layered_column(c)).collect();
+        assert!(!sliding.is_empty());
+        for c in sliding {
+            assert_eq!(slides[c], Slide::Plane(zmin), "column {c}");
+            assert_eq!(n.columns[c].direction.z, 0.0);
+        }
+        assert!((0..n.columns.len()).filter(|&c| !on_floor(c)).all(|c| slides[c] == Slide::Free));
+    }
+
+    #[test]
     fn a_line_slide_stays_on_both_planes() {
         let a = Plane { origin: DVec3::ZERO, normal: DVec3::new(0.6, 0.8, 0.0) };
         let b = Plane { origin: DVec3::new(0.0, 0.0, 1.0), normal: DVec3::new(0.0, 0.6, 0.8) };
