@@ -63,11 +63,15 @@ pub enum Role {
     /// Viscous wall: gets layers.
     #[default]
     Wall,
+    /// A plane the layers slide along (their columns there stay on it). The cut face of a body
+    /// in an external flow: the farfield becomes a half box whose face on the plane is the
+    /// symmetry patch.
     Symmetry,
     Farfield,
     Inlet,
     Outlet,
-    /// Any other boundary without layers.
+    /// Any other boundary without layers. On every patch without layers that is planar, the
+    /// columns of the walls around it slide in its plane, so the layers end against it.
     None,
 }
 

@@ -376,7 +376,7 @@ fn check_covers(
             *used.entry(edge(p, q)).or_default() += 1;
         }
     }
-    match boundary.iter().find(|e| used.get(e) != Some(&1)) {
+    match boundary.iter().find(|&&(a, b)| used.get(&edge(a, b)) != Some(&1)) {
         Some(&(a, b)) => {
             Err(format!("the boundary edge {a}-{b} at {:?} is not closed off", points[a as usize]))
         }
