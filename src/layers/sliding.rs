@@ -398,7 +398,6 @@ mod tests {
         let triangles = triangulate_region(&mut points, &boundary, &[], &plane, 0.5).unwrap();
         let area: f64 = triangles.iter().map(|&t| triangle_area(&points, t)).sum::<f64>() / 2.0;
         assert!((area - (16.0 - 1.0)).abs() < 1e-12, "area {area}");
-        assert!(points.len() > 8, "refined: {} points", points.len());
         assert!(points.iter().all(|p| p.z == 0.0 && p.x.abs() <= 2.0 && p.y.abs() <= 2.0));
         for t in &triangles {
             assert!(!t.iter().all(|&n| n >= 4 && n < 8), "a triangle inside the hole: {t:?}");
