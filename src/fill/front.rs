@@ -150,7 +150,8 @@ impl CoreBuild {
                 *uses.entry((a.min(b), a.max(b))).or_default() += 1;
             }
         }
-        let open: Vec<(u32, u32)> = uses.into_iter().filter(|&(_, n)| n == 1).map(|(e, _)| e).collect();
+        let mut open: Vec<(u32, u32)> = uses.into_iter().filter(|&(_, n)| n == 1).map(|(e, _)| e).collect();
+        open.sort_unstable(); // the same mesh on every run
         let plane = symmetry.plane;
         let tolerance = 1e-9 * wall.bounding_box().diagonal();
         if let Some(&(a, _)) = open.iter().find(|&&(a, b)| {

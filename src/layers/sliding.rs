@@ -224,8 +224,9 @@ fn retriangulate(
             *boundary.entry(edge(face[i], face[(i + 1) % face.len()])).or_default() += 1;
         }
     }
-    let boundary: Vec<(u32, u32)> =
+    let mut boundary: Vec<(u32, u32)> =
         boundary.into_iter().filter(|(_, n)| n % 2 == 1).map(|(e, _)| e).collect();
+    boundary.sort_unstable(); // the same mesh on every run
     let on_border: HashSet<u32> = border.iter().flat_map(|&(a, b)| [a, b]).collect();
     let mut interior: Vec<u32> = patch.iter().flatten().copied().filter(|n| !on_border.contains(n)).collect();
     interior.sort_unstable();
