@@ -328,8 +328,9 @@ pub fn fill_core_on_symmetry_plane(
 }
 
 /// Fill the core of `layers` (built by [`crate::layers::build_layers`] from `wall` exactly as
-/// that got it: validated, and flipped for internal flow; its points are the mesh's first
-/// points) and return the whole mesh: the layer cells, the pyramids on the front
+/// that got it: validated, and flipped for internal flow; or the wall
+/// [`crate::layers::sliding::close_sliding_patches`] returns when columns slid on patches
+/// without layers; its points are the mesh's first points) and return the whole mesh: the layer cells, the pyramids on the front
 /// quads and the core tetrahedra (zone [`CORE_ZONE_NAME`]); boundary patches are the wall's and
 /// [`FARFIELD_PATCH`] (the layers' top faces are interior now).
 pub fn fill_core_with(
