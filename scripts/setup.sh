@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Installs what blmesh's build and tests need on a fresh Debian machine with Rust: TetGen
-# (libtet1.5-dev, for the core fill behind the default cargo feature `tetgen`),
+# (libtet1.5-dev, for the core fill behind the default cargo feature `tetgen`), the CGNS library
+# and its tools (libcgns-dev for the cargo feature `cgns`, cgns-convert for cgnscheck and
+# cgns_to_vtk in the tests),
 # the system libraries the Gmsh Python wheel loads, and a venv with gmsh + meshio (used by the
 # interoperability tests that read our files back with other tools). Idempotent.
 set -euo pipefail
@@ -8,7 +10,7 @@ cd "$(dirname "$0")/.."
 
 SUDO=""
 if [ "$(id -u)" != 0 ]; then SUDO="sudo"; fi
-APT_PACKAGES="libtet1.5-dev python3-venv libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libfontconfig1 libfreetype6 libgomp1"
+APT_PACKAGES="libtet1.5-dev libcgns-dev cgns-convert python3-venv libglu1-mesa libgl1 libxcursor1 libxft2 libxinerama1 libxrender1 libxfixes3 libxext6 libx11-6 libfontconfig1 libfreetype6 libgomp1"
 missing=""
 for p in $APT_PACKAGES; do
   dpkg -s "$p" >/dev/null 2>&1 || missing="$missing $p"

@@ -9,7 +9,7 @@ use std::process::ExitCode;
 use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 
-use crate::config::{Config, LayerCount};
+use crate::config::{Config, LayerCount, Role};
 use crate::io::{self, MeshFormat};
 use crate::pipeline::{self, MeshOptions};
 use crate::progress::Progress;
@@ -189,15 +189,31 @@ fn check(path: &Path, json: bool) -> Result<ExitCode> {
     Ok(if report.is_valid() { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
 }
 
+/// The role of every patch of the mesh: the config's, except that a patch the config leaves a
+/// wall by default but that blmesh made (the farfield, the layer top) gets its own role.
+fn patch_roles(patch_names: &[String], config: &Config) -> Vec<Role> {
+    patch_names
+        .iter()
+        .map(|name| match config.patch_settings(name).0 {
+            Role::Wall => io::cgns::default_role(name),
+            role => role,
+        })
+        .collect()
+}
+
 fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
     let format = MeshFormat::from_path(&args.output, args.ascii).with_context(|| {
         format!("{}: unknown output format (expected {})", args.output.display(), io::MESH_EXTENSIONS)
     })?;
+    if let Some(why) = format.unavailable() {
+        bail!("{}: {why}", args.output.display());
+    }
     let config = mesh_config(args)?;
     let surface = io::read_surface(&args.input)?;
     let options = MeshOptions { core: !args.no_core };
     let out = pipeline::run(surface, &config, &options, progress)?;
-    io::write_volume_mesh(&args.output, &out.mesh, format)
+    let roles = patch_roles(&out.mesh.patch_names, &config);
+    io::write_volume_mesh_with_roles(&args.output, &out.mesh, format, &roles)
         .with_context(|| format!("{}: cannot write", args.output.display()))?;
     if let Some(report_path) = &args.report {
         let text = serde_json::to_string_pretty(&out.report)?;

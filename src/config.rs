@@ -37,6 +37,9 @@ pub const DEFAULT_FEATURE_ANGLE: f64 = 30.0;
 pub const DEFAULT_FAN_ANGLE: f64 = 20.0;
 /// More layers than this is certainly a mistake (and a memory blow-up).
 pub const MAX_LAYER_COUNT: u32 = 1000;
+/// With `count = "auto"`, the most layers a column gets when its cells never become isotropic
+/// (a given `thickness` caps the stack instead).
+pub const AUTO_MAX_LAYERS: u32 = 60;
 
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
 #[serde(rename_all = "lowercase")]
@@ -332,6 +335,8 @@ pub struct LayerSpec {
     pub first_height: f64,
     pub growth: f64,
     pub count: LayerCount,
+    /// See [`LayerSpec::max_count`].
+    max_count: u32,
 }
 
 impl LayerSpec {
@@ -344,7 +349,17 @@ impl LayerSpec {
             (None, Some(t)) => LayerCount::Fixed(layers_for_thickness(first_height, growth, t)?),
             (None, None) => LayerCount::Fixed(DEFAULT_LAYER_COUNT),
         };
-        Ok(LayerSpec { first_height, growth, count })
+        let max_count = match (count, s.thickness) {
+            (LayerCount::Fixed(n), _) => n,
+            (LayerCount::Auto, Some(t)) => layers_for_thickness(first_height, growth, t)?,
+            (LayerCount::Auto, None) => AUTO_MAX_LAYERS,
+        };
+        Ok(LayerSpec { first_height, growth, count, max_count })
+    }
+
+    /// The most layers a column gets: the fixed count, or the cap of an automatic one.
+    pub fn max_count(&self) -> u32 {
+        self.max_count
     }
 
     /// The layer count, unless it is decided while marching (`count = "auto"`).

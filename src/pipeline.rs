@@ -3,7 +3,7 @@
 
 use serde::Serialize;
 
-use crate::config::{Config, ConfigError, Flow, LayerCount, LayerSpec, Role};
+use crate::config::{Config, ConfigError, Flow, LayerSpec, Role};
 use crate::fill::{fill_core_on_symmetry_plane, CoreOptions, CoreStats, FillError};
 use crate::layers::sliding::SlidingError;
 use crate::layers::{self, MarchStats};
@@ -88,6 +88,7 @@ pub struct LayerSummary {
     /// Wall vertices whose column stopped before its target, with a few examples.
     pub stopped_vertices: usize,
     pub stopped_examples: Vec<[f64; 3]>,
+    pub smoothness: crate::layers::smoothness::Smoothness,
 }
 
 #[derive(Clone, Debug, Default, Serialize)]
@@ -222,13 +223,7 @@ fn patch_layer_specs(
             if !role.has_layers() {
                 return Ok(None);
             }
-            let spec = LayerSpec::resolve(&settings, body_size)?;
-            if spec.count == LayerCount::Auto {
-                return Err(MeshError::Unsupported(format!(
-                    "patch {name}: count = \"auto\" needs the sizing field, which is not implemented yet"
-                )));
-            }
-            Ok(Some(spec))
+            Ok(Some(LayerSpec::resolve(&settings, body_size)?))
         })
         .collect()
 }
@@ -289,6 +284,7 @@ fn layer_summary(layered: &layers::Layers, surface: &Surface, features: &Feature
             .take(5)
             .map(|&v| surface.points[v as usize].to_array())
             .collect(),
+        smoothness: layered.smoothness.clone(),
     }
 }
 
@@ -319,6 +315,25 @@ impl std::fmt::Display for MeshReport {
             100.0 * l.convex_coverage,
             l.stopped_vertices
         )?;
+        let sm = &l.smoothness;
+        write!(
+            f,
+            "smooth    neighbour thickness ratio median {:.3}, p95 {:.3}, max {:.3}; layer growth within r at {:.1}% of columns",
+            sm.neighbour_thickness_ratio.median,
+            sm.neighbour_thickness_ratio.p95,
+            sm.neighbour_thickness_ratio.max,
+            100.0 * sm.layer_height_ratio.within_band
+        )?;
+        if sm.isotropy_ratio.count > 0 {
+            write!(
+                f,
+                "; last height / front edge at {} isotropic stops: median {:.2}, within [1/r, r] at {:.1}%",
+                sm.isotropy_ratio.count,
+                sm.isotropy_ratio.median,
+                100.0 * sm.isotropy_ratio.within_band
+            )?;
+        }
+        writeln!(f)?;
         writeln!(
             f,
             "normals   {} columns ({} in fans over {} convex ridge edges, {} corner patches)",

@@ -137,3 +137,33 @@ fn spot_and_bunny_layers_are_valid() {
         );
     }
 }
+
+/// `count = "auto"` (issue 4): every column of the box and the sphere ends its stack where its
+/// next layer would be as high as the front is wide (or the wall, where a convex front widens
+/// faster than the layers grow), the mesh passes the checker, every wall vertex completes its
+/// stack, and the stacks end smoothly: neighbouring thicknesses within two growth ratios.
+#[test]
+fn auto_count_stops_at_isotropy_smoothly() {
+    for surface in [shapes::cuboid(DVec3::new(2.0, 1.5, 1.0), 6), shapes::icosphere(1.0, 3)] {
+        let config = Config {
+            layers: LayerSettings {
+                first_height: Some(1e-3 * surface.bounding_box().diagonal()),
+                growth: Some(GROWTH),
+                count: Some(LayerCount::Auto),
+                thickness: None,
+            },
+            ..Default::default()
+        };
+        let out = run(surface.clone(), &config, &MeshOptions { core: false }, Progress::hidden())
+            .expect("meshing a valid surface succeeds");
+        assert!(out.report.check.is_valid(), "{}", out.report.check);
+        let layers = &out.report.layers;
+        assert_eq!(layers.full_coverage, 1.0, "every stack ends at isotropy, none early");
+        let s = &layers.smoothness;
+        assert!(s.isotropy_ratio.count > 0);
+        // The last layer is lower than the size that ended the stack, and not by more than r.
+        assert!(s.isotropy_ratio.max < 1.0 && s.isotropy_ratio.median > 0.3, "{:?}", s.isotropy_ratio);
+        assert!(s.neighbour_thickness_ratio.max <= GROWTH * GROWTH, "{:?}", s.neighbour_thickness_ratio);
+        assert_eq!(s.layer_height_ratio.within_band, 1.0, "{:?}", s.layer_height_ratio);
+    }
+}

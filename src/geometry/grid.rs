@@ -70,7 +70,7 @@ pub fn overlapping_pairs_where(
             for (i, &(k, a)) in group.iter().enumerate() {
                 for &(_, b) in &group[i + 1..] {
                     let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
-                    if !(is_query[a as usize] || is_query[b as usize]) || !overlap(ba, bb) {
+                    if !(is_query[a as usize] || is_query[b as usize]) || !ba.overlaps(bb) {
                         continue;
                     }
                     // Report from one cell only.
@@ -87,7 +87,7 @@ pub fn overlapping_pairs_where(
         for a in 0..boxes.len() as u32 {
             if a != b
                 && (is_query[a as usize] || is_query[b as usize])
-                && overlap(&boxes[a as usize], &boxes[b as usize])
+                && boxes[a as usize].overlaps(&boxes[b as usize])
                 && keep(a.min(b), a.max(b))
             {
                 pairs.push((a.min(b), a.max(b)));
@@ -99,10 +99,6 @@ pub fn overlapping_pairs_where(
     pairs
 }
 
-fn overlap(a: &Aabb, b: &Aabb) -> bool {
-    a.min.cmple(b.max).all() && b.min.cmple(a.max).all()
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -112,7 +108,7 @@ mod tests {
         let mut out = Vec::new();
         for a in 0..boxes.len() {
             for b in a + 1..boxes.len() {
-                if (q[a] || q[b]) && overlap(&boxes[a], &boxes[b]) {
+                if (q[a] || q[b]) && boxes[a].overlaps(&boxes[b]) {
                     out.push((a as u32, b as u32));
                 }
             }

@@ -43,6 +43,11 @@ impl Aabb {
     pub fn center(&self) -> DVec3 {
         0.5 * (self.min + self.max)
     }
+
+    /// Whether the two closed boxes have a point in common (touching counts).
+    pub fn overlaps(&self, other: &Aabb) -> bool {
+        self.min.cmple(other.max).all() && other.min.cmple(self.max).all()
+    }
 }
 
 /// Twice the signed area vector of triangle (a, b, c): its direction is the right-hand normal.

@@ -43,6 +43,55 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
     Sign::of(-robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
 }
 
+/// Relative error bound of the floating-point `orient3d` determinant over its permanent
+/// (Shewchuk's first stage, "errboundA"), with the half-ulp epsilon of f64.
+const ORIENT3D_ERROR_A: f64 = (7.0 + 56.0 * HALF_EPSILON) * HALF_EPSILON;
+const HALF_EPSILON: f64 = f64::EPSILON / 2.0;
+
+/// Exact [`orient3d`] for many tetrahedra whose points all lie in one box (the corners and
+/// centres of one cell): a static error bound from the box's extents decides the sign from the
+/// plain floating-point determinant, and only the near-degenerate cases go to the adaptive
+/// predicate. Every coordinate difference is at most the extent on its axis, so the permanent
+/// that bounds the determinant's error is at most 6 ex ey ez (padded for rounding).
+#[derive(Clone, Copy, Debug)]
+pub struct BoxedOrient3d {
+    bound: f64,
+}
+
+impl BoxedOrient3d {
+    /// For points inside the box of `points`, or means of up to 8 of them computed in floating
+    /// point (they may round out of the box by a few ulps of the coordinates: padded for).
+    pub fn new(points: &[DVec3]) -> Self {
+        let (mut lo, mut hi) = (DVec3::splat(f64::INFINITY), DVec3::splat(f64::NEG_INFINITY));
+        for &p in points {
+            lo = lo.min(p);
+            hi = hi.max(p);
+        }
+        let magnitude = lo.abs().max(hi.abs());
+        let e = (hi - lo + magnitude * (32.0 * f64::EPSILON)) * (1.0 + 1e-12);
+        // The permanent's six terms, each an x, a y and a z difference; 1% pad for rounding.
+        BoxedOrient3d { bound: ORIENT3D_ERROR_A * 6.06 * e.x * e.y * e.z }
+    }
+
+    /// [`orient3d`] of points inside the box (a point outside it gives a wrong answer).
+    #[inline]
+    pub fn orient3d(&self, a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
+        let (ad, bd, cd) = (a - d, b - d, c - d);
+        // The determinant robust::orient3d computes, negated for our convention.
+        let det = -(ad.z * (bd.x * cd.y - cd.x * bd.y)
+            + bd.z * (cd.x * ad.y - ad.x * cd.y)
+            + cd.z * (ad.x * bd.y - bd.x * ad.y));
+        if !(det.abs() > self.bound) {
+            return orient3d(a, b, c, d);
+        }
+        if det > 0.0 {
+            Sign::Positive
+        } else {
+            Sign::Negative
+        }
+    }
+}
+
 /// Exact orientation of 2D points: `Positive` when `(a, b, c)` turn counter-clockwise.
 pub fn orient2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> Sign {
     let p = |v: [f64; 2]| robust::Coord { x: v[0], y: v[1] };
@@ -84,6 +133,26 @@ mod tests {
                 prop_assert_eq!(s, if v > 0.0 { Sign::Positive } else { Sign::Negative });
             }
             prop_assert_eq!(orient3d(b, a, c, d), s.flip());
+        }
+
+        /// The boxed filter gives the exact sign, also for nearly flat tetrahedra (d pulled
+        /// towards the plane of a, b, c by a tiny amount) and for points in a tiny far box.
+        #[test]
+        fn boxed_agrees_with_exact(
+            p in proptest::array::uniform12(-1.0f64..1.0),
+            flatness in prop_oneof![Just(0.0), 1e-18f64..1e-12, 1e-6f64..1.0],
+            offset in prop_oneof![Just(0.0), -1e6f64..1e6],
+            scale in prop_oneof![Just(1.0), 1e-9f64..1e-3],
+        ) {
+            let q = |i: usize| DVec3::new(p[i], p[i + 1], p[i + 2]) * scale + DVec3::splat(offset);
+            let (a, b, c) = (q(0), q(3), q(6));
+            // d near the plane of a, b, c: a point of it plus a small normal offset.
+            let on_plane = a + (b - a) * p[9].abs() + (c - a) * p[10].abs() * 0.5;
+            let d = on_plane + (b - a).cross(c - a) * flatness * p[11];
+            let filter = BoxedOrient3d::new(&[a, b, c, d]);
+            prop_assert_eq!(filter.orient3d(a, b, c, d), orient3d(a, b, c, d));
+            prop_assert_eq!(filter.orient3d(b, a, c, d), orient3d(b, a, c, d));
+            prop_assert_eq!(filter.orient3d(d, b, c, a), orient3d(d, b, c, a));
         }
     }
 }

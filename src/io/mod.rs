@@ -5,6 +5,7 @@
 //! [`write_atomic`], so a failed run never leaves a half-written output file.
 
 pub mod cart3d;
+pub mod cgns;
 pub mod medit;
 pub mod msh;
 pub mod obj;
@@ -19,6 +20,7 @@ use std::fmt;
 use std::io::Write;
 use std::path::{Path, PathBuf};
 
+use crate::config::Role;
 use crate::mesh::VolumeMesh;
 use crate::surface::Surface;
 
@@ -132,13 +134,19 @@ pub fn read_surface(path: &Path) -> Result<Surface, ReadError> {
     format.parse(&bytes).map_err(|source| ReadError::Parse { path: path.to_owned(), source })
 }
 
-/// Read a volume mesh (`.msh` Gmsh 4.1/2.2, `.vtu`).
+/// Read a volume mesh (`.msh` Gmsh 4.1/2.2, `.vtu`, `.cgns` with the `cgns` feature).
 pub fn read_volume_mesh(path: &Path) -> Result<VolumeMesh, ReadError> {
     let ext = path.extension().and_then(|e| e.to_str()).map(str::to_ascii_lowercase);
     let parse: fn(&[u8]) -> Result<VolumeMesh, ParseError> = match ext.as_deref() {
         Some("msh") => msh::parse_volume,
         Some("vtu") => vtu::parse,
-        _ => return Err(ReadError::UnknownFormat { path: path.to_owned(), expected: ".msh, .vtu" }),
+        // The CGNS library reads the file itself.
+        Some("cgns") => {
+            return cgns::read(path)
+                .map(|file| file.mesh)
+                .map_err(|e| ReadError::Parse { path: path.to_owned(), source: ParseError::file(e.message) })
+        }
+        _ => return Err(ReadError::UnknownFormat { path: path.to_owned(), expected: ".msh, .vtu, .cgns" }),
     };
     let bytes = read_bytes(path)?;
     parse(&bytes).map_err(|source| ReadError::Parse { path: path.to_owned(), source })
@@ -158,10 +166,12 @@ pub enum MeshFormat {
     Medit {
         binary: bool,
     },
+    /// CGNS (HDF5): one unstructured zone, patches as boundary conditions (feature `cgns`).
+    Cgns,
 }
 
 /// The volume mesh output extensions, for messages.
-pub const MESH_EXTENSIONS: &str = ".msh, .vtu, .su2, .mesh, .meshb";
+pub const MESH_EXTENSIONS: &str = ".msh, .vtu, .su2, .mesh, .meshb, .cgns";
 
 impl MeshFormat {
     pub fn from_path(path: &Path, ascii: bool) -> Option<Self> {
@@ -172,19 +182,37 @@ impl MeshFormat {
             "su2" => Some(MeshFormat::Su2),
             "mesh" => Some(MeshFormat::Medit { binary: false }),
             "meshb" => Some(MeshFormat::Medit { binary: true }),
+            "cgns" => Some(MeshFormat::Cgns),
             _ => None,
         }
+    }
+
+    /// Why this build cannot write the format (checked before meshing), if it cannot.
+    pub fn unavailable(self) -> Option<&'static str> {
+        (self == MeshFormat::Cgns && !cgns::AVAILABLE).then_some(cgns::NOT_BUILT)
     }
 }
 
 /// Write a volume mesh atomically in the given format.
 pub fn write_volume_mesh(path: &Path, mesh: &VolumeMesh, format: MeshFormat) -> std::io::Result<()> {
-    write_atomic(path, |w| match format {
-        MeshFormat::Msh { ascii } => msh::write(w, mesh, ascii),
-        MeshFormat::Vtu => vtu::write(w, mesh),
-        MeshFormat::Su2 => su2::write(w, mesh),
-        MeshFormat::Medit { binary } => medit::write_volume(w, mesh, binary),
-    })
+    write_volume_mesh_with_roles(path, mesh, format, &[])
+}
+
+/// [`write_volume_mesh`] with the role of each patch (CGNS boundary condition types; patches
+/// beyond `roles` get [`cgns::default_role`]).
+pub fn write_volume_mesh_with_roles(
+    path: &Path,
+    mesh: &VolumeMesh,
+    format: MeshFormat,
+    roles: &[Role],
+) -> std::io::Result<()> {
+    match format {
+        MeshFormat::Msh { ascii } => write_atomic(path, |w| msh::write(w, mesh, ascii)),
+        MeshFormat::Vtu => write_atomic(path, |w| vtu::write(w, mesh)),
+        MeshFormat::Su2 => write_atomic(path, |w| su2::write(w, mesh)),
+        MeshFormat::Medit { binary } => write_atomic(path, |w| medit::write_volume(w, mesh, binary)),
+        MeshFormat::Cgns => cgns::write(path, mesh, roles),
+    }
 }
 
 /// Write a file through a temporary in the same directory, renamed over `path` only when
@@ -193,16 +221,37 @@ pub fn write_atomic(
     path: &Path,
     write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
+    replace_through_temporary(path, |tmp| {
+        let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
+        write(&mut buffered)?;
+        buffered.flush()
+    })
+}
+
+/// [`write_atomic`] for a writer that opens the file itself (a C library): it gets the path of
+/// the temporary, which it may replace.
+pub fn write_atomic_via_path(
+    path: &Path,
+    write: impl FnOnce(&Path) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    replace_through_temporary(path, |tmp| {
+        write(tmp.path())?;
+        // Reopen: the writer may have replaced the file the temporary's handle points to.
+        *tmp.as_file_mut() = std::fs::OpenOptions::new().read(true).write(true).open(tmp.path())?;
+        Ok(())
+    })
+}
+
+fn replace_through_temporary(
+    path: &Path,
+    fill: impl FnOnce(&mut tempfile::NamedTempFile) -> std::io::Result<()>,
+) -> std::io::Result<()> {
     let dir = match path.parent() {
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
     let mut tmp = tempfile::Builder::new().prefix(".blmesh-").tempfile_in(dir)?;
-    {
-        let mut buffered = std::io::BufWriter::new(tmp.as_file_mut());
-        write(&mut buffered)?;
-        buffered.flush()?;
-    }
+    fill(&mut tmp)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
     Ok(())
@@ -224,6 +273,17 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
         write_atomic(&path, |w| w.write_all(b"whole")).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"whole");
+    }
+
+    #[test]
+    fn cgns_output_is_available_exactly_with_the_feature() {
+        let format = MeshFormat::from_path(Path::new("out.CGNS"), false);
+        assert_eq!(format, Some(MeshFormat::Cgns));
+        assert_eq!(MeshFormat::Cgns.unavailable().is_some(), !cfg!(feature = "cgns"));
+        if let Some(why) = MeshFormat::Cgns.unavailable() {
+            assert!(why.contains("--features cgns"), "{why}");
+        }
+        assert_eq!(MeshFormat::Su2.unavailable(), None);
     }
 
     #[test]

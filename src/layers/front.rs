@@ -27,6 +27,13 @@ pub struct Columns {
     pub merged_into: Vec<u32>,
     /// Where the column may go: its nodes are projected onto a patch plane when it slides.
     pub slide: Vec<Slide>,
+    /// For a column that ended its stack because its next cell would have been isotropic: its
+    /// last layer's height over the front's tangential size then; NaN for the others.
+    pub isotropic_ratio: Vec<f64>,
+    /// Length of the column's last step (its last layer's height along it).
+    pub last_step: Vec<f64>,
+    /// The ratio of a step to the one before that is farthest from 1 (0 before two steps).
+    pub max_step_ratio: Vec<f64>,
 }
 
 /// `Columns::merged_into` of a column that has not merged.
@@ -171,6 +178,33 @@ impl Front {
         self.column_faces = faces;
     }
 
+    /// The front's tangential size at every column: the mean length of the front edges at the
+    /// columns of its wall vertex (NaN if there are none). Edges between two copies of one wall
+    /// vertex (fan edges) are left out: they measure the opening of a fan, which grows with the
+    /// distance until tangential refinement splits it; so all the columns of a vertex, corner
+    /// webs included, get the size of the front along the wall. An edge inside the front counts
+    /// once from each face.
+    pub fn mean_edge_length_at_columns(&self, points: &[DVec3], columns: &Columns) -> Vec<f64> {
+        let vertices = columns.wall_vertex.iter().max().map_or(0, |&v| v as usize + 1);
+        let mut sum = vec![0.0; vertices];
+        let mut count = vec![0u32; vertices];
+        for face in 0..self.len() {
+            let cols = self.face_columns(face);
+            for i in 0..cols.len() {
+                let (a, b) = (cols[i] as usize, cols[(i + 1) % cols.len()] as usize);
+                let (va, vb) = (columns.wall_vertex[a] as usize, columns.wall_vertex[b] as usize);
+                let length = points[columns.node[a] as usize].distance(points[columns.node[b] as usize]);
+                if length > 0.0 && va != vb {
+                    for v in [va, vb] {
+                        sum[v] += length;
+                        count[v] += 1;
+                    }
+                }
+            }
+        }
+        columns.wall_vertex.iter().map(|&v| sum[v as usize] / count[v as usize] as f64).collect()
+    }
+
     /// The faces touching any of `columns`, each once.
     pub fn faces_around_columns(&self, columns: &[u32]) -> Vec<usize> {
         let mut faces: Vec<usize> = columns.iter().flat_map(|&c| self.faces_of(c)).collect();
@@ -193,6 +227,9 @@ pub fn initial_front(surface: &Surface, normals: &WallNormals) -> (Columns, Fron
         columns.layers.push(0);
         columns.wall_vertex.push(seed.vertex);
         columns.merged_into.push(NOT_MERGED);
+        columns.isotropic_ratio.push(f64::NAN);
+        columns.last_step.push(0.0);
+        columns.max_step_ratio.push(0.0);
     }
     columns.slide = normals.slides.clone();
     columns.slide.resize(columns.len(), Slide::Free);

@@ -1,87 +1,242 @@
 //! The new front must not cross itself: each cell of a slab can be valid while two parts of the
 //! front pass through each other (fronts meeting at a concave ridge, across a thin gap, or a fan
 //! sweeping over its neighbours). The proposed front is tested with the same exact triangle
-//! tests as the input surface; faces sharing a vertex are left to the cells' validity test,
+//! tests as the input surface; triangles sharing a vertex are left to the cells' validity test,
 //! which sees any fold between neighbours.
+//!
+//! Finding the pairs of faces to test is what costs (a broad phase over the whole front), so
+//! [`CrossingGuard`] finds them once for several layers: from each face's box swept over the
+//! motion of those layers (columns move on straight lines, so the box of a face's start and end
+//! positions holds every position in between). While the front keeps its faces and columns
+//! their directions, each layer only tests the cached pairs, exactly.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
 use super::slab::Polygon;
+use crate::geometry::grid::overlapping_pairs_where;
+use crate::geometry::intersect::triangles_intersect;
+use crate::geometry::Aabb;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
 use crate::quality::validity::cell_validity;
-use crate::surface::validate::intersecting_pairs_with;
-use crate::surface::Surface;
 
-/// The faces of the proposed front that cross another face of it, its quads taken with the
-/// pyramid the core fill will cap them with; and the quads that no pyramid can cap.
-/// Only `suspects` are tested against the rest: the faces whose top moved since the last test.
-pub(super) fn crossing_faces(
-    plan: &SlabPlan,
-    mesh: &VolumeMesh,
-    columns: &Columns,
-    front: &Front,
-    suspects: &[usize],
-) -> Vec<usize> {
-    let committed = mesh.points.len() as u32;
-    let mut points = mesh.points.clone();
-    points.extend_from_slice(&plan.proposed);
-    // Top polygon of every front face, triangulated; `owner[t]` is its face.
-    let mut triangles = Vec::with_capacity(front.len() * 2);
-    let mut owner = Vec::with_capacity(front.len() * 2);
-    let mut uncappable = Vec::new();
-    let mut suspect = vec![false; front.len()];
-    for &f in suspects {
-        suspect[f] = true;
+/// Layers one set of candidate pairs covers when no collapse changes the front.
+pub const LOOKAHEAD_LAYERS: u32 = 4;
+
+/// Candidate pairs of front faces that may cross up to a given layer.
+#[derive(Debug, Default)]
+pub(super) struct CrossingGuard {
+    /// Face pairs `(f, g)`, `f < g`, whose swept boxes overlap.
+    pairs: Vec<(u32, u32)>,
+    /// The last layer the pairs hold for; `None` before the first build and after the front
+    /// changed (collapses, redirected columns).
+    valid_through: Option<u32>,
+    /// The plan's collapse count when the pairs were built: a new merge moves a face's top to
+    /// another column's position, outside its swept box.
+    collapses_at_build: usize,
+    pub rebuilds: usize,
+}
+
+/// Where every column is at the end of the guard's horizon, and the horizon's last layer.
+pub(super) struct Reach {
+    pub end: Vec<DVec3>,
+    pub through_layer: u32,
+}
+
+impl CrossingGuard {
+    /// Whether the pairs must be rebuilt before testing layer `k` under `plan`.
+    pub fn is_stale(&self, k: u32, plan: &SlabPlan) -> bool {
+        self.valid_through.is_none_or(|last| k > last) || plan.collapses != self.collapses_at_build
     }
-    for f in 0..front.len() {
-        let top: Vec<u32> = front
-            .face_columns(f)
-            .iter()
-            .map(|&c| {
-                let r = plan.merges.root(c);
-                if plan.moving[r as usize] {
-                    committed + r
-                } else {
-                    columns.node[c as usize]
+
+    /// The front changed under the pairs (faces merged, columns turned): rebuild next time.
+    pub fn invalidate(&mut self) {
+        self.valid_through = None;
+    }
+
+    /// Find the face pairs whose boxes, swept from the committed front to `reach`, overlap.
+    pub fn rebuild(
+        &mut self,
+        plan: &SlabPlan,
+        mesh: &VolumeMesh,
+        columns: &Columns,
+        front: &Front,
+        reach: Reach,
+    ) {
+        let bottom = |c: u32| mesh.points[columns.node[c as usize] as usize];
+        let swept: Vec<(Aabb, bool)> = (0..front.len())
+            .into_par_iter()
+            .map(|f| {
+                let cols = front.face_columns(f);
+                let mut b = Aabb::empty();
+                let mut moves = false;
+                for &c in cols {
+                    let (start, end) = (bottom(c), reach.end[c as usize]);
+                    moves |= start != end;
+                    b.grow(start);
+                    b.grow(end);
                 }
+                if cols.len() == 4 {
+                    // The pyramid cap's apex lies within half an edge of the quad's centre.
+                    let pad = DVec3::splat(0.5 * b.diagonal());
+                    b = Aabb { min: b.min - pad, max: b.max + pad };
+                }
+                (b, moves)
             })
             .collect();
-        let Some(polygon) = Polygon::dedup(&top) else { continue };
-        let n = polygon.nodes();
-        if n.len() == 3 {
-            triangles.push([n[0], n[1], n[2]]);
-            owner.push(f);
-            continue;
-        }
-        // A quad is seen as the core fill will see it: capped by a pyramid.
-        let Some(apex) = pyramid_apex([0, 1, 2, 3].map(|i| points[n[i] as usize])) else {
-            if suspect[f] {
-                uncappable.push(f);
-            }
-            continue;
+        let (boxes, moving): (Vec<Aabb>, Vec<bool>) = swept.into_iter().unzip();
+        // Two triangles sharing a column share a top vertex: the cells' validity judges them.
+        let keep = |f: u32, g: u32| {
+            let (a, b) = (front.face_columns(f as usize), front.face_columns(g as usize));
+            a.len() == 4 || b.len() == 4 || !a.iter().any(|c| b.contains(c))
         };
-        let a = points.len() as u32;
-        points.push(apex);
-        for k in 0..4 {
-            triangles.push([n[k], n[(k + 1) % 4], a]);
-            owner.push(f);
+        self.pairs = overlapping_pairs_where(&boxes, &moving, keep);
+        self.valid_through = Some(reach.through_layer);
+        self.collapses_at_build = plan.collapses;
+        self.rebuilds += 1;
+    }
+
+    /// The faces of the proposed front that cross another face of it, its quads taken with the
+    /// pyramid the core fill will cap them with; and the quads that no pyramid can cap.
+    /// Only pairs with a face among `suspects` (the faces whose top moved since the last test)
+    /// are tested.
+    pub fn crossing_faces(
+        &self,
+        plan: &SlabPlan,
+        mesh: &VolumeMesh,
+        columns: &Columns,
+        front: &Front,
+        suspects: &[usize],
+    ) -> Vec<usize> {
+        let mut suspect = vec![false; front.len()];
+        for &f in suspects {
+            suspect[f] = true;
+        }
+        let top = TopFront { plan, mesh, columns, front };
+        // Most cached pairs are apart now: their current boxes sort them out cheaply.
+        let boxes: Vec<Aabb> = (0..front.len()).into_par_iter().map(|f| top.cap_box(f)).collect();
+        let tested: Vec<(u32, u32)> = self
+            .pairs
+            .par_iter()
+            .copied()
+            .filter(|&(f, g)| {
+                (suspect[f as usize] || suspect[g as usize]) && boxes[f as usize].overlaps(&boxes[g as usize])
+            })
+            .collect();
+        let mut shape_of = vec![u32::MAX; front.len()];
+        let mut needed = Vec::new();
+        for f in tested.iter().flat_map(|&(f, g)| [f, g]) {
+            if shape_of[f as usize] == u32::MAX {
+                shape_of[f as usize] = needed.len() as u32;
+                needed.push(f as usize);
+            }
+        }
+        let shapes: Vec<TopShape> = needed.par_iter().map(|&f| top.shape(f)).collect();
+        let shape = |f: u32| &shapes[shape_of[f as usize] as usize];
+        let mut faces: Vec<usize> = tested
+            .par_iter()
+            .filter(|&&(f, g)| shape(f).crosses(shape(g)))
+            .flat_map_iter(|&(f, g)| [f as usize, g as usize])
+            .collect();
+        let uncappable = |f: usize| front.face_columns(f).len() == 4 && top.shape(f).uncappable;
+        faces.par_extend(suspects.par_iter().copied().filter(|&f| uncappable(f)));
+        faces.sort_unstable();
+        faces.dedup();
+        faces
+    }
+}
+
+/// The proposed top of the front faces under a slab plan.
+struct TopFront<'a> {
+    plan: &'a SlabPlan,
+    mesh: &'a VolumeMesh,
+    columns: &'a Columns,
+    front: &'a Front,
+}
+
+/// A face's proposed top as triangles: the top triangle, or a quad's four pyramid-cap triangles.
+/// Vertex ids are the proposal's node ids (an apex gets an id of its own), so that triangles
+/// sharing a vertex are recognised.
+#[derive(Default)]
+struct TopShape {
+    ids: Vec<[u32; 3]>,
+    points: Vec<[DVec3; 3]>,
+    boxes: Vec<Aabb>,
+    uncappable: bool,
+}
+
+impl TopFront<'_> {
+    fn node_and_position(&self, c: u32) -> (u32, DVec3) {
+        let committed = self.mesh.points.len() as u32;
+        let r = self.plan.merges.root(c);
+        if self.plan.moving[r as usize] {
+            (committed + r, self.plan.proposed[r as usize])
+        } else {
+            let node = self.columns.node[c as usize];
+            (node, self.mesh.points[node as usize])
         }
     }
-    let count = triangles.len();
-    let surface =
-        Surface { points, triangles, triangle_patch: vec![0; count], patch_names: vec!["front".into()] };
-    let moved: Vec<u32> = (0..count as u32).filter(|&t| suspect[owner[t as usize]]).collect();
-    let mut faces: Vec<usize> = intersecting_pairs_with(&surface, &moved, true)
-        .into_iter()
-        .flat_map(|(a, b)| [owner[a as usize], owner[b as usize]])
-        .collect();
-    faces.extend(uncappable);
-    faces.sort_unstable();
-    faces.dedup();
-    faces
+
+    /// A box around face `f`'s proposed top and the cap it may get.
+    fn cap_box(&self, f: usize) -> Aabb {
+        let cols = self.front.face_columns(f);
+        let mut b = Aabb::empty();
+        for &c in cols {
+            b.grow(self.node_and_position(c).1);
+        }
+        if cols.len() < 4 {
+            return b;
+        }
+        let pad = DVec3::splat(0.5 * b.diagonal());
+        Aabb { min: b.min - pad, max: b.max + pad }
+    }
+
+    fn shape(&self, f: usize) -> TopShape {
+        let mut shape = TopShape::default();
+        let top: Vec<(u32, DVec3)> =
+            self.front.face_columns(f).iter().map(|&c| self.node_and_position(c)).collect();
+        let ids: Vec<u32> = top.iter().map(|t| t.0).collect();
+        let Some(polygon) = Polygon::dedup(&ids) else { return shape };
+        let at = |id: u32| top.iter().find(|t| t.0 == id).map_or(DVec3::ZERO, |t| t.1);
+        let n = polygon.nodes();
+        if n.len() == 3 {
+            shape.push([n[0], n[1], n[2]], [n[0], n[1], n[2]].map(at));
+            return shape;
+        }
+        let x = [0, 1, 2, 3].map(|i| at(n[i]));
+        let Some(apex) = pyramid_apex(x) else {
+            shape.uncappable = true;
+            return shape;
+        };
+        let apex_id = u32::MAX - f as u32;
+        for k in 0..4 {
+            let (a, b) = (k, (k + 1) % 4);
+            shape.push([n[a], n[b], apex_id], [x[a], x[b], apex]);
+        }
+        shape
+    }
+}
+
+impl TopShape {
+    fn push(&mut self, ids: [u32; 3], points: [DVec3; 3]) {
+        self.ids.push(ids);
+        self.boxes.push(Aabb::from_points(&points));
+        self.points.push(points);
+    }
+
+    /// Whether a triangle of `self` and one of `other` that share no vertex touch (exact).
+    fn crosses(&self, other: &TopShape) -> bool {
+        (0..self.ids.len()).any(|i| {
+            (0..other.ids.len()).any(|j| {
+                !self.ids[i].iter().any(|v| other.ids[j].contains(v))
+                    && self.boxes[i].overlaps(&other.boxes[j])
+                    && triangles_intersect(self.points[i], other.points[j])
+            })
+        })
+    }
 }
 
 /// Apex heights tried for a pyramid on a front quad: half its shortest edge, then halved.
@@ -100,4 +255,71 @@ pub fn pyramid_apex(x: [DVec3; 4]) -> Option<DVec3> {
         p[4] = apex;
         cell_validity(CellKind::Pyramid, &p).is_valid()
     })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::layers::collapse::Merges;
+
+    /// Two triangles marching towards each other: a floor rising from z = 0 and a tilted triangle
+    /// sinking from z = 0.6, 0.1 per layer each. Their tops first touch at layer 3 (floor at
+    /// 0.3, the other's lowest edge at 0.3). The pairs found at layer 1 for four layers must
+    /// still catch it.
+    #[test]
+    fn cached_pairs_catch_a_crossing_layers_later() {
+        let floor = [DVec3::new(0.0, 0.0, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(0.0, 1.0, 0.0)];
+        let tilted = [DVec3::new(0.1, 0.1, 0.6), DVec3::new(0.4, 0.1, 0.6), DVec3::new(0.2, 0.2, 1.5)];
+        let mut mesh = VolumeMesh { points: [floor, tilted].concat(), ..Default::default() };
+        let mut columns = Columns::default();
+        for (i, &p) in mesh.points.iter().enumerate() {
+            columns.base.push(p);
+            columns.dir.push(if i < 3 { DVec3::Z } else { -DVec3::Z });
+            columns.scale.push(1.0);
+            columns.node.push(i as u32);
+            columns.alive.push(true);
+            columns.layers.push(0);
+            columns.wall_vertex.push(i as u32);
+            columns.merged_into.push(crate::layers::front::NOT_MERGED);
+        }
+        let mut front = Front::default();
+        front.push(&[0, 1, 2], 0, None);
+        front.push(&[3, 5, 4], 0, None);
+        front.index_columns(6);
+        let mut guard = CrossingGuard::default();
+        let mut crossings = Vec::new();
+        for k in 1..=3u32 {
+            let proposed: Vec<DVec3> =
+                (0..6).map(|c| mesh.points[columns.node[c] as usize] + columns.dir[c] * 0.1).collect();
+            let plan = SlabPlan {
+                moving: vec![true; 6],
+                proposed: proposed.clone(),
+                merges: Merges::new(6),
+                redirected: Vec::new(),
+                collapses: 0,
+            };
+            if guard.is_stale(k, &plan) {
+                let end: Vec<DVec3> = (0..6)
+                    .map(|c| {
+                        mesh.points[columns.node[c] as usize]
+                            + columns.dir[c] * (0.1 * LOOKAHEAD_LAYERS as f64)
+                    })
+                    .collect();
+                guard.rebuild(
+                    &plan,
+                    &mesh,
+                    &columns,
+                    &front,
+                    Reach { end, through_layer: k + LOOKAHEAD_LAYERS - 1 },
+                );
+            }
+            crossings.push(guard.crossing_faces(&plan, &mesh, &columns, &front, &[0, 1]));
+            for (c, p) in proposed.into_iter().enumerate() {
+                columns.node[c] = mesh.points.len() as u32;
+                mesh.points.push(p);
+            }
+        }
+        assert_eq!(guard.rebuilds, 1);
+        assert_eq!(crossings, vec![vec![], vec![], vec![0, 1]]);
+    }
 }

@@ -15,7 +15,7 @@ use rayon::prelude::*;
 use super::collapse::Merges;
 use super::entropy;
 use super::front::{Columns, Front};
-use super::guard;
+use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Polygon, SlabCell};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -35,6 +35,8 @@ pub struct MarchStats {
     pub steiner_points: usize,
     /// Front edges collapsed where fronts met (two columns merged into one).
     pub collapses: usize,
+    /// Times the crossing guard searched the whole front for candidate pairs.
+    pub guard_rebuilds: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -154,21 +156,29 @@ fn face_nodes(
 
 /// March `layers` steps (or until every column has stopped), appending points and cells to
 /// `mesh`. `distance(c, k)` is how far column `c` should be from the wall after `k` layers, or
-/// `None` when its stack is complete.
+/// `None` when its stack is complete. Columns with `stop_when_isotropic[c]` also end their stack
+/// before the first layer whose height would reach the front's edge length around them
+/// (`count = "auto"`); they are marked in `columns.isotropic_ratio`.
 pub fn march(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
     max_layers: u32,
     distance: impl Fn(usize, u32) -> Option<f64> + Sync,
+    stop_when_isotropic: &[bool],
     mut on_layer: impl FnMut(u32),
 ) -> MarchStats {
     let mut stats = MarchStats::default();
+    let mut guard = CrossingGuard::default();
+    let wall_size = front.mean_edge_length_at_columns(&mesh.points, columns);
     for k in 1..=max_layers {
         for c in 0..columns.len() {
             if columns.alive[c] && distance(c, k).is_none() {
                 columns.alive[c] = false;
             }
+        }
+        if stop_when_isotropic.iter().any(|&s| s) {
+            stop_isotropic_columns(mesh, columns, front, k, &distance, stop_when_isotropic, &wall_size);
         }
         if !columns.alive.iter().any(|&a| a) {
             break;
@@ -183,20 +193,128 @@ pub fn march(
                 _ => DVec3::ZERO,
             })
             .collect();
-        let plan = settle_slab(mesh, columns, front, proposed);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut guard, k, &distance);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses;
+        if plan.collapses > 0 || !plan.redirected.is_empty() {
+            guard.invalidate();
+        }
         commit_slab(mesh, columns, front, &plan, &mut stats);
         stats.layers_marched = k;
         on_layer(k);
     }
+    stats.guard_rebuilds = guard.rebuilds;
     stats
+}
+
+/// End the stacks of the columns whose next layer (the `k`-th) would be at least as high as the
+/// front's tangential size around them ([`Front::mean_edge_length_at_columns`]): its cells would
+/// be isotropic, which the core's tetrahedra do better. Where the front widens faster than the
+/// layers grow (convex walls coarser than the growth rate can follow, until tangential
+/// refinement splits their edges), the wall's own tangential size `wall_size` ends the stack
+/// instead.
+fn stop_isotropic_columns(
+    mesh: &VolumeMesh,
+    columns: &mut Columns,
+    front: &Front,
+    k: u32,
+    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
+    stop_when_isotropic: &[bool],
+    wall_size: &[f64],
+) {
+    let edge = front.mean_edge_length_at_columns(&mesh.points, columns);
+    let ended = ended_neighbour_layers(columns, front);
+    let ends = |c: usize| {
+        let (Some(d), Some(d_before)) = (distance(c, k), distance(c, k - 1)) else { return false };
+        // A neighbour's stack ended more than one layer lower: end here too, so that the stacks
+        // step down one layer at a time (no cliff in the final front).
+        let cliff = ended[c] < columns.layers[c];
+        cliff || d - d_before >= edge[c].min(wall_size[c])
+    };
+    let candidates: Vec<bool> =
+        (0..columns.len()).map(|c| columns.alive[c] && stop_when_isotropic[c]).collect();
+    // The columns of one wall vertex (a fan) end together: a fan strip cell with one side
+    // stopped and the other moving would be flat.
+    let mut vertex_ends = vec![false; columns.wall_vertex.iter().max().map_or(0, |&v| v as usize + 1)];
+    for c in (0..columns.len()).filter(|&c| candidates[c] && ends(c)) {
+        vertex_ends[columns.wall_vertex[c] as usize] = true;
+    }
+    for c in 0..columns.len() {
+        if candidates[c] && vertex_ends[columns.wall_vertex[c] as usize] {
+            columns.alive[c] = false;
+            // The last layer built, against the tangential size it ended at.
+            let (d_before, d_last) =
+                (distance(c, k - 1).unwrap_or(0.0), k.checked_sub(2).and_then(|j| distance(c, j)));
+            columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / edge[c];
+        }
+    }
+}
+
+/// For every column, the fewest layers of a neighbour (across a front edge) whose stack ended at
+/// isotropy (`u32::MAX` if none).
+fn ended_neighbour_layers(columns: &Columns, front: &Front) -> Vec<u32> {
+    let mut fewest = vec![u32::MAX; columns.len()];
+    for f in 0..front.len() {
+        let cols = front.face_columns(f);
+        for i in 0..cols.len() {
+            let (a, b) = (cols[i] as usize, cols[(i + 1) % cols.len()] as usize);
+            for (c, n) in [(a, b), (b, a)] {
+                if !columns.isotropic_ratio[n].is_nan() {
+                    fewest[c] = fewest[c].min(columns.layers[n]);
+                }
+            }
+        }
+    }
+    fewest
+}
+
+/// Where every column will be at the end of the guard's horizon: after layer `k` if the slab
+/// has merged columns (they move to other columns' positions), else after the next
+/// [`LOOKAHEAD_LAYERS`] layers if it keeps moving (or its last layer, if that comes first).
+fn reach(
+    plan: &SlabPlan,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    k: u32,
+    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
+) -> Reach {
+    let committed = mesh.points.len() as u32;
+    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    if plan.collapses > 0 {
+        let end =
+            (0..columns.len() as u32).map(|c| proposal.position(plan.top(c, columns, committed))).collect();
+        return Reach { end, through_layer: k };
+    }
+    let last = k + LOOKAHEAD_LAYERS - 1;
+    let end = (0..columns.len())
+        .into_par_iter()
+        .map(|c| {
+            let node = mesh.points[columns.node[c] as usize];
+            let now = distance(c, k - 1);
+            let ahead = (k..=last).rev().find_map(|j| distance(c, j));
+            match (now, ahead) {
+                (Some(d0), Some(d1)) if plan.moving[c] => {
+                    node + columns.dir[c] * (columns.scale[c] * (d1 - d0))
+                }
+                _ => node,
+            }
+        })
+        .collect();
+    Reach { end, through_layer: last }
 }
 
 /// Decide which columns move and merge so that every cell of the slab is valid and the new
 /// front does not cross itself.
-fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Vec<DVec3>) -> SlabPlan {
+fn settle_slab(
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    proposed: Vec<DVec3>,
+    guard: &mut CrossingGuard,
+    k: u32,
+    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
+) -> SlabPlan {
     let mut plan = SlabPlan {
         moving: columns.alive.clone(),
         proposed,
@@ -211,7 +329,10 @@ fn settle_slab(mesh: &VolumeMesh, columns: &Columns, front: &Front, proposed: Ve
         .collect();
     loop {
         repair_invalid_cells(&mut plan, mesh, columns, front, to_check);
-        let crossing = guard::crossing_faces(&plan, mesh, columns, front, &suspects);
+        if guard.is_stale(k, &plan) {
+            guard.rebuild(&plan, mesh, columns, front, reach(&plan, mesh, columns, k, distance));
+        }
+        let crossing = guard.crossing_faces(&plan, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
         for f in crossing {
             tracing::debug!(face = f, "the new front crosses itself: stopping the face's columns");
@@ -295,20 +416,27 @@ fn commit_slab(
             }
         })
         .collect();
-    for f in 0..front.len() {
-        let cols = front.face_columns(f);
-        let n = cols.len();
-        let mut b = [0; 4];
-        let mut t = [0; 4];
-        for (i, &c) in cols.iter().enumerate() {
-            b[i] = columns.node[c as usize];
-            t[i] = top[c as usize];
-        }
-        if b[..n] != t[..n] {
+    // The cells are decided in parallel, then emitted in face order (deterministic output).
+    let cells: Vec<(bool, SlabCell)> = (0..front.len())
+        .into_par_iter()
+        .map(|f| {
+            let cols = front.face_columns(f);
+            let n = cols.len();
+            let mut b = [0; 4];
+            let mut t = [0; 4];
+            for (i, &c) in cols.iter().enumerate() {
+                b[i] = columns.node[c as usize];
+                t[i] = top[c as usize];
+            }
+            (b[..n] != t[..n], slab_cell(&b[..n], &t[..n]))
+        })
+        .collect();
+    for (f, (moved, cell)) in cells.into_iter().enumerate() {
+        if moved {
             // The top is now front, even under a flat cell whose top lies on a neighbour's face.
             front.raise(f);
         }
-        emit_cell(mesh, slab_cell(&b[..n], &t[..n]), stats);
+        emit_cell(mesh, cell, stats);
     }
     for c in 0..columns.len() {
         let r = plan.merges.root(c as u32) as usize;
@@ -319,6 +447,11 @@ fn commit_slab(
             columns.merged_into[c] = r as u32;
             columns.node[c] = top[c];
         } else {
+            record_step(
+                columns,
+                c,
+                mesh.points[columns.node[c] as usize].distance(mesh.points[top[c] as usize]),
+            );
             columns.node[c] = top[c];
             columns.layers[c] += 1;
         }
@@ -330,6 +463,19 @@ fn commit_slab(
     if plan.collapses > 0 {
         front.apply_merges(plan.merges.roots());
     }
+}
+
+/// Remember column `c`'s new step and how it compares with the one before.
+fn record_step(columns: &mut Columns, c: usize, step: f64) {
+    let before = columns.last_step[c];
+    if before > 0.0 && step > 0.0 {
+        let ratio = step / before;
+        let worst = columns.max_step_ratio[c];
+        if worst == 0.0 || ratio.ln().abs() > worst.ln().abs() {
+            columns.max_step_ratio[c] = ratio;
+        }
+    }
+    columns.last_step[c] = step;
 }
 
 fn emit_cell(mesh: &mut VolumeMesh, cell: SlabCell, stats: &mut MarchStats) {

@@ -11,6 +11,7 @@ pub mod guard;
 pub mod march;
 pub mod slab;
 pub mod sliding;
+pub mod smoothness;
 
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
@@ -37,6 +38,7 @@ pub struct Layers {
     pub vertex_target: Vec<Option<u32>>,
     /// Where columns stopped early: wall vertex ids (all of them; the report shows a few).
     pub stopped_vertices: Vec<u32>,
+    pub smoothness: smoothness::Smoothness,
 }
 
 /// Extrude the wall. `patch_spec[p]` is the layer stack of patch `p`, `None` for patches
@@ -55,7 +57,8 @@ pub fn build_layers(
     for (c, spec) in column_spec.iter().enumerate() {
         columns.alive[c] = spec.is_some() && columns.slide[c] != Slide::Fixed;
     }
-    let target = |c: usize| column_spec[c].map(|s| s.fixed_count().unwrap_or(0));
+    let target = |c: usize| column_spec[c].map(|s| s.max_count());
+    let auto: Vec<bool> = column_spec.iter().map(|s| s.is_some_and(|s| s.fixed_count().is_none())).collect();
     let max_layers = (0..columns.len()).filter_map(target).max().unwrap_or(0);
     let mut mesh = VolumeMesh {
         points: surface.points.clone(),
@@ -64,9 +67,12 @@ pub fn build_layers(
     };
     let distance =
         |c: usize, k: u32| column_spec[c].filter(|_| k <= target(c).unwrap_or(0)).map(|s| s.distance(k));
-    let stats =
-        march::march(&mut mesh, &mut columns, &mut front, max_layers, distance, |k| on_layer(k, max_layers));
+    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, distance, &auto, |k| {
+        on_layer(k, max_layers)
+    });
     add_boundary(&mut mesh, surface, &front, &columns);
+    let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
+    let smoothness = smoothness::measure(surface, &mesh, &columns, growth);
     let mut vertex_layers: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut vertex_target: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut stopped_vertices = Vec::new();
@@ -74,7 +80,10 @@ pub fn build_layers(
         let v = columns.wall_vertex[c] as usize;
         if let Some(t) = target(c) {
             // A column that merged is carried on by the bisector column it merged into.
-            let reached = columns.layers[columns.carrier(c)];
+            let carrier = columns.carrier(c);
+            let reached = columns.layers[carrier];
+            // A stack ended at isotropy is complete.
+            let t = if columns.isotropic_ratio[carrier].is_nan() { t } else { reached };
             vertex_layers[v] = Some(vertex_layers[v].map_or(reached, |l| l.min(reached)));
             vertex_target[v] = Some(vertex_target[v].map_or(t, |x| x.max(t)));
             if reached < t {
@@ -84,7 +93,7 @@ pub fn build_layers(
     }
     stopped_vertices.sort_unstable();
     stopped_vertices.dedup();
-    Layers { mesh, stats, vertex_layers, vertex_target, stopped_vertices }
+    Layers { mesh, stats, vertex_layers, vertex_target, stopped_vertices, smoothness }
 }
 
 /// The layer stack of each column: that of the first front face using it, `None` if any face

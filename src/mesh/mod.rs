@@ -16,6 +16,8 @@
 //! top: VTK wedge = Gmsh prism permuted by [`CellKind::vtk_permutation`]. SU2 files use the VTK
 //! orders (meshio's SU2 reader does not permute them back: its wedges read from `.su2` are
 //! inverted in its own convention).
+//! CGNS (`TETRA_4`, `PYRA_5`, `PENTA_6`, `HEXA_8` of the SIDS) uses the Gmsh orders above: its
+//! face tables list the same outward faces ([`CellKind::cgns_type`]).
 //! Medit (`.mesh`/`.meshb`) cells are written in the Gmsh orders above, unpermuted: meshio's
 //! Medit reader and writer apply no permutation to any kind, so meshio reads them as valid
 //! cells. (libMeshb's own documentation was not checked for its pyramid/prism figures.)
@@ -102,6 +104,21 @@ impl CellKind {
             CellKind::Prism => 6,
             CellKind::Hexahedron => 5,
         }
+    }
+
+    /// CGNS `ElementType_t` value (same node order as ours).
+    pub fn cgns_type(self) -> i32 {
+        match self {
+            CellKind::Tetrahedron => 10,
+            CellKind::Pyramid => 12,
+            CellKind::Prism => 14,
+            CellKind::Hexahedron => 17,
+        }
+    }
+
+    /// The kind of a CGNS `ElementType_t` value, if it is one of the four linear volume cells.
+    pub fn from_cgns_type(t: i32) -> Option<CellKind> {
+        CellKind::ALL.into_iter().find(|k| k.cgns_type() == t)
     }
 
     /// VTK cell type number.

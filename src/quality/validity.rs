@@ -11,7 +11,7 @@ use super::measures::{
     dihedral_range, edge_face_pairs, for_each_subtet, scaled_jacobian, volume, CellPoints,
 };
 use super::report::{CellRef, InvalidCell, KindQuality, Validity, EXAMPLES};
-use crate::geometry::predicates::{orient3d, Sign};
+use crate::geometry::predicates::{BoxedOrient3d, Sign};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 
@@ -32,6 +32,10 @@ impl CellValidity {
 
 /// Exact validity of one cell.
 pub fn cell_validity(kind: CellKind, x: &CellPoints) -> CellValidity {
+    // Centroid and quad centres lie in the box of the corners (up to rounding, which the
+    // filter's padding covers).
+    let orient3d = BoxedOrient3d::new(&x[..kind.node_count()]);
+    let orient3d = |a, b, c, d| orient3d.orient3d(a, b, c, d);
     let bad_corner = kind.corners().iter().enumerate().find_map(|(i, &[o, a, b, d])| {
         let s = orient3d(x[o], x[a], x[b], x[d]);
         (s != Sign::Positive).then_some((i, s))

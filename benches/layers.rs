@@ -1,0 +1,53 @@
+//! Benchmark of the layer stage (issue 3's target: at least 2 million layer cells per second on
+//! the bunny with 20 layers, h0 = 1e-4 of the bounding-box diagonal, r = 1.2).
+//!
+//! `cargo bench --bench layers` runs the stage several times and prints the median time, the
+//! cells per second and the peak memory; under `cargo test --all-targets` it runs once as a smoke
+//! test. A plain harness: criterion's statistics add nothing to a half-second stage.
+
+use std::time::{Duration, Instant};
+
+use blmesh::config::{LayerCount, LayerSettings, LayerSpec};
+use blmesh::layers::build_layers;
+use blmesh::normals::wall_normals;
+use blmesh::surface::features::Features;
+use blmesh::surface::topology::Topology;
+use blmesh::surface::validate::{validate, ValidationOptions};
+
+const BUNNY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/bunny_closed_herholz.off");
+
+fn main() {
+    let full = std::env::args().any(|a| a == "--bench");
+    let runs = if full { 7 } else { 1 };
+    let mut surface = blmesh::io::read_surface(BUNNY.as_ref()).expect("the bunny reads");
+    validate(&mut surface, &ValidationOptions::default()).expect("the bunny is valid");
+    let body_size = surface.bounding_box().diagonal();
+    let topology = Topology::new(&surface);
+    let features = Features::compute(&surface, &topology, 30.0);
+    let normals = wall_normals(&surface, &topology, &features, 20.0);
+    let settings = LayerSettings {
+        first_height: Some(1e-4 * body_size),
+        growth: Some(1.2),
+        count: Some(LayerCount::Fixed(20)),
+        thickness: None,
+    };
+    let spec = LayerSpec::resolve(&settings, body_size).expect("a valid layer spec");
+    let patch_spec = vec![Some(spec); surface.patch_names.len()];
+    let mut times: Vec<Duration> = Vec::new();
+    let mut cells = 0;
+    for _ in 0..runs {
+        let start = Instant::now();
+        let layers = build_layers(&surface, &normals, &patch_spec, |_, _| {});
+        times.push(start.elapsed());
+        cells = layers.mesh.cell_count();
+    }
+    times.sort();
+    let median = times[times.len() / 2].as_secs_f64();
+    let memory = blmesh::progress::peak_memory_mib().map_or("?".to_owned(), |m| format!("{m:.0} MiB"));
+    println!(
+        "layers/bunny-20: {cells} cells, median {median:.3} s over {runs} runs (min {:.3} s), \
+         {:.2} M cells/s, peak memory {memory}",
+        times[0].as_secs_f64(),
+        cells as f64 / median / 1e6
+    );
+}

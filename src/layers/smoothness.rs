@@ -1,0 +1,108 @@
+//! How smoothly the layers end and grow (issue 4's smoothness report): neighbouring wall
+//! vertices should end at similar thicknesses, consecutive layers should grow by at most the
+//! growth ratio, and a stack ended at isotropy should end with a last layer about as high as the
+//! front is wide there.
+
+use serde::Serialize;
+
+use super::front::Columns;
+use crate::mesh::VolumeMesh;
+use crate::surface::topology::Topology;
+use crate::surface::Surface;
+
+/// A distribution of ratios: quantiles, the largest, and the fraction within a tolerance band.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct RatioStats {
+    pub count: usize,
+    pub median: f64,
+    pub p95: f64,
+    pub max: f64,
+    /// Fraction of the ratios within the band given where it is computed.
+    pub within_band: f64,
+}
+
+impl RatioStats {
+    /// Stats of `ratios` (all >= 1 or all two-sided), counting those within [lo, hi].
+    pub fn of(mut ratios: Vec<f64>, lo: f64, hi: f64) -> RatioStats {
+        ratios.retain(|r| r.is_finite());
+        if ratios.is_empty() {
+            return RatioStats::default();
+        }
+        ratios.sort_by(f64::total_cmp);
+        let at = |q: f64| ratios[((ratios.len() - 1) as f64 * q).round() as usize];
+        let within = ratios.iter().filter(|&&r| (lo..=hi).contains(&r)).count();
+        RatioStats {
+            count: ratios.len(),
+            median: at(0.5),
+            p95: at(0.95),
+            max: at(1.0),
+            within_band: within as f64 / ratios.len() as f64,
+        }
+    }
+}
+
+/// The smoothness report of the layers.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct Smoothness {
+    /// Over the wall edges whose two vertices have layers: the larger final thickness over the
+    /// smaller (band [1, r]).
+    pub neighbour_thickness_ratio: RatioStats,
+    /// Over the columns: the largest ratio of a layer's height to the one below it (band
+    /// [1/r, r]; merged columns are re-aimed, which changes their step).
+    pub layer_height_ratio: RatioStats,
+    /// Over the stacks ended at isotropy (`count = "auto"`): the last layer's height over the
+    /// front's tangential size when it ended ([`Front::mean_edge_length_at_columns`]; band
+    /// [1/r, r]).
+    pub isotropy_ratio: RatioStats,
+}
+
+/// Measure the layers' smoothness. `growth` is the (largest) growth ratio, for the bands.
+pub fn measure(surface: &Surface, mesh: &VolumeMesh, columns: &Columns, growth: f64) -> Smoothness {
+    let thickness = vertex_thickness(surface, mesh, columns);
+    let topology = Topology::new(surface);
+    let neighbour: Vec<f64> = topology
+        .edges
+        .iter()
+        .filter_map(|e| {
+            let (a, b) = (thickness[e[0] as usize]?, thickness[e[1] as usize]?);
+            (a.min(b) > 0.0).then(|| a.max(b) / a.min(b))
+        })
+        .collect();
+    let steps: Vec<f64> =
+        (0..columns.len()).map(|c| columns.max_step_ratio[c]).filter(|&r| r > 0.0).collect();
+    let isotropy: Vec<f64> = columns.isotropic_ratio.iter().copied().filter(|r| !r.is_nan()).collect();
+    Smoothness {
+        neighbour_thickness_ratio: RatioStats::of(neighbour, 1.0, growth * (1.0 + 1e-9)),
+        layer_height_ratio: RatioStats::of(steps, 1.0 / growth - 1e-9, growth * (1.0 + 1e-9)),
+        isotropy_ratio: RatioStats::of(isotropy, 1.0 / growth, growth),
+    }
+}
+
+/// Final thickness at every wall vertex with layers: the largest distance from it to the top of
+/// one of its columns (followed through merges).
+fn vertex_thickness(surface: &Surface, mesh: &VolumeMesh, columns: &Columns) -> Vec<Option<f64>> {
+    let mut thickness: Vec<Option<f64>> = vec![None; surface.points.len()];
+    for c in 0..columns.len() {
+        let top = mesh.points[columns.node[columns.carrier(c)] as usize];
+        let v = columns.wall_vertex[c] as usize;
+        if columns.layers[columns.carrier(c)] > 0 {
+            let t = top.distance(surface.points[v]);
+            thickness[v] = Some(thickness[v].map_or(t, |x: f64| x.max(t)));
+        }
+    }
+    thickness
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn ratio_stats_count_the_band() {
+        let s = RatioStats::of(vec![1.0, 1.1, 1.2, 1.5, f64::NAN], 1.0, 1.2);
+        assert_eq!(s.count, 4);
+        assert_eq!(s.max, 1.5);
+        assert!((s.within_band - 0.75).abs() < 1e-12);
+        assert_eq!(RatioStats::of(vec![], 1.0, 2.0).count, 0);
+    }
+}
