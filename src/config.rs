@@ -66,11 +66,15 @@ pub enum Role {
     /// Viscous wall: gets layers.
     #[default]
     Wall,
+    /// A plane the layers slide along (their columns there stay on it). The cut face of a body
+    /// in an external flow: the farfield becomes a half box whose face on the plane is the
+    /// symmetry patch.
     Symmetry,
     Farfield,
     Inlet,
     Outlet,
-    /// Any other boundary without layers.
+    /// Any other boundary without layers. On every patch without layers that is planar, the
+    /// columns of the walls around it slide in its plane, so the layers end against it.
     None,
 }
 
@@ -227,6 +231,18 @@ impl Config {
             validate_layer_settings(&format!("patch {:?}", rule.pattern), &rule.layers)?;
         }
         Ok(())
+    }
+
+    /// The `[[patch]]` patterns that match none of `patch_names` (most likely a mistake).
+    pub fn unmatched_rules(&self, patch_names: &[String]) -> Vec<&str> {
+        self.patches
+            .iter()
+            .filter(|rule| {
+                let whole = format!("^(?:{})$", rule.pattern);
+                regex::Regex::new(&whole).is_ok_and(|re| !patch_names.iter().any(|n| re.is_match(n)))
+            })
+            .map(|rule| rule.pattern.as_str())
+            .collect()
     }
 
     /// Role and layer settings of a patch: the last matching `[[patch]]` rule wins.

@@ -3,10 +3,12 @@
 
 use serde::Serialize;
 
-use crate::config::{Config, ConfigError, Flow, LayerSpec};
-use crate::fill::{fill_core, CoreOptions, CoreStats, FillError};
+use crate::config::{Config, ConfigError, Flow, LayerSpec, Role};
+use crate::fill::{fill_core_on_symmetry_plane, CoreOptions, CoreStats, FillError};
+use crate::layers::sliding::SlidingError;
 use crate::layers::{self, MarchStats};
 use crate::mesh::{CellKind, VolumeMesh};
+use crate::normals::constraint::{self, Plane};
 use crate::normals::{self, NormalStats};
 use crate::progress::{Progress, Timings};
 use crate::quality::{self, CheckReport};
@@ -33,6 +35,8 @@ pub enum MeshError {
     Unsupported(String),
     #[error("core fill failed: {0} (the layers alone can be written with --no-core)")]
     Fill(#[from] FillError),
+    #[error("the layers cannot be closed against a patch without layers: {0}")]
+    Sliding(#[from] SlidingError),
     #[error("the mesh failed its own check (a bug in blmesh; please report it):\n{0}")]
     InvalidResult(Box<CheckReport>),
 }
@@ -124,29 +128,62 @@ pub fn run(
         surface.flip_all();
     }
     let body_size = surface.bounding_box().diagonal();
+    warnings.extend(config.unmatched_rules(&surface.patch_names).into_iter().map(|pattern| {
+        format!("[[patch]] match = {pattern:?} matches no patch (it must match a whole name)")
+    }));
     let patch_spec = patch_layer_specs(&surface, config, body_size)?;
+    let layered_patch: Vec<bool> = patch_spec.iter().map(Option::is_some).collect();
+    let symmetry_patch: Vec<bool> =
+        surface.patch_names.iter().map(|name| config.patch_settings(name).0 == Role::Symmetry).collect();
+    // Columns slide on the planar patches without layers, whose vertices are snapped onto
+    // their planes first.
+    let planes = constraint::snap_planar_patches(&mut surface, &layered_patch);
+    warnings.extend(not_planar_warnings(&surface, &layered_patch, &planes));
     let (topology, features) = timings.time("features", || {
         let topology = Topology::new(&surface);
         let features = Features::compute(&surface, &topology, config.feature_angle());
         (topology, features)
     });
-    let wall_normals =
-        timings.time("normals", || normals::wall_normals(&surface, &topology, &features, config.fan_angle()));
+    let wall_normals = timings.time("normals", || {
+        let fan_angle = config.fan_angle();
+        let mut n =
+            normals::wall_normals_of_layered(&surface, &topology, &features, fan_angle, &layered_patch);
+        n.slides = constraint::constrain_columns(&surface, &mut n, &layered_patch, &planes);
+        n
+    });
     let bar = progress.bar(0, "layers");
-    let layered = timings.time("layers", || {
-        layers::build_layers(&surface, &wall_normals, &patch_spec, |k, n| {
+    let (mut layered, core_wall) = timings.time("layers", || {
+        let mut layered = layers::build_layers(&surface, &wall_normals, &patch_spec, |k, n| {
             bar.set_length(n as u64);
             bar.set_position(k as u64);
-        })
+        });
+        let core_wall =
+            layers::sliding::close_sliding_patches(&mut layered.mesh, &surface, &planes, &symmetry_patch);
+        (layered, core_wall)
     });
     bar.finish_and_clear();
+    let closed = core_wall?;
+    let symmetry = match closed.symmetry.as_slice() {
+        [] => None,
+        [one] => Some(one),
+        [_, more @ ..] => {
+            let names: Vec<&str> =
+                more.iter().map(|s| surface.patch_names[s.patch as usize].as_str()).collect();
+            return Err(MeshError::Unsupported(format!(
+                "more than one symmetry plane with the body on it (also {names:?}): the farfield can \
+                 be cut by one only"
+            )));
+        }
+    };
     let layer_summary = layer_summary(&layered, &surface, &features);
     let (mesh, core) = if options.core {
-        let (mesh, stats) =
-            timings.time("core", || fill_core(&layered.mesh, &surface, &CoreOptions::from_config(config)))?;
+        let (mesh, stats) = timings.time("core", || {
+            let options = CoreOptions::from_config(config);
+            fill_core_on_symmetry_plane(&layered.mesh, &closed.core_wall, &options, symmetry)
+        })?;
         (mesh, Some(stats))
     } else {
-        (layered.mesh, None)
+        (std::mem::take(&mut layered.mesh), None)
     };
     let check = timings.time("check", || quality::check(&mesh));
     if !check.is_valid() {
@@ -187,6 +224,21 @@ fn patch_layer_specs(
                 return Ok(None);
             }
             Ok(Some(LayerSpec::resolve(&settings, body_size)?))
+        })
+        .collect()
+}
+
+/// A warning for every patch without layers that is not planar: columns cannot slide on it,
+/// so the layers stop where they meet it.
+fn not_planar_warnings(surface: &Surface, layered_patch: &[bool], planes: &[Option<Plane>]) -> Vec<String> {
+    let counts = surface.patch_triangle_counts();
+    (0..surface.patch_names.len())
+        .filter(|&p| !layered_patch[p] && planes[p].is_none() && counts[p] > 0)
+        .map(|p| {
+            format!(
+                "patch {} gets no layers and is not planar: the layers stop where they meet it",
+                surface.patch_names[p]
+            )
         })
         .collect()
 }

@@ -178,15 +178,15 @@ fn improvement_raises_the_worst_angle_of_the_box() {
     assert_eq!(q.slivers.count, below_10(&q.histogram));
 }
 
-/// A patch without layers: its wall triangles are the core's boundary as they are, next to the
-/// steps where the neighbouring layers stop.
+/// A patch without layers (not a symmetry plane): its wall triangles are the core's boundary as
+/// they are, next to the layer faces that slid off its edges in its plane (they join the front).
 #[test]
 fn box_with_a_patch_without_layers() {
     let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
     let mut cfg = config(&wall, 10);
     cfg.patches.push(PatchRule {
         pattern: "xmin".into(),
-        role: Some(Role::Symmetry),
+        role: Some(Role::Outlet),
         layers: Default::default(),
     });
     let layers = layered(&wall, &cfg);

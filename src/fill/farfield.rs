@@ -5,6 +5,7 @@
 use super::{FarfieldSpec, FillError, DEFAULT_FARFIELD_CELL, FARFIELD_PATCH};
 use crate::config::FarfieldShape;
 use crate::geometry::{Aabb, DVec3};
+use crate::normals::constraint::Plane;
 use crate::surface::{shapes, Surface};
 
 /// The farfield must leave room around the body and its layers.
@@ -41,6 +42,41 @@ pub fn farfield(spec: &FarfieldSpec, body: Aabb) -> Result<Surface, FillError> {
     shell.patch_names = vec![FARFIELD_PATCH.to_owned()];
     shell.triangle_patch = vec![0; shell.triangles.len()];
     Ok(shell)
+}
+
+/// The farfield of a body on a symmetry plane: the cube of [`farfield`] moved onto the fluid's
+/// side of `plane` (its normal into the fluid, along an axis), one face on the plane exactly,
+/// and that face left open (the symmetry face is triangulated around the body's footprint by
+/// the caller); facing inward, as one patch [`FARFIELD_PATCH`].
+pub fn half_box(spec: &FarfieldSpec, body: Aabb, plane: &Plane) -> Result<Surface, FillError> {
+    let Some(axis) = (0..3).find(|&a| plane.normal[a].abs() == 1.0) else {
+        return Err(FillError::Options(format!(
+            "a symmetry plane must be normal to a coordinate axis for the half-box farfield; its \
+             normal is {:?}",
+            plane.normal.to_array()
+        )));
+    };
+    let mut centre = body.center();
+    let on_plane = plane.origin[axis];
+    let spec = FarfieldSpec { shape: FarfieldShape::Box, ..*spec };
+    let mut cube = farfield(&spec, body)?;
+    // Half the cube's side: the distance from the centre to its faces.
+    let half = cube.points.iter().map(|p| (p[axis] - centre[axis]).abs()).fold(0.0, f64::max);
+    centre[axis] = on_plane + plane.normal[axis] * half;
+    let shift = centre[axis] - body.center()[axis];
+    for p in &mut cube.points {
+        p[axis] += shift;
+        if (p[axis] - on_plane).abs() <= 1e-9 * half {
+            p[axis] = on_plane;
+        }
+    }
+    let on_face = |t: &[u32; 3], points: &[DVec3]| t.iter().all(|&v| points[v as usize][axis] == on_plane);
+    let keep: Vec<bool> = cube.triangles.iter().map(|t| !on_face(t, &cube.points)).collect();
+    let mut kept = keep.iter();
+    cube.triangles.retain(|_| kept.next().copied().unwrap_or(true));
+    cube.triangle_patch.truncate(cube.triangles.len());
+    cube.remove_unused_points();
+    Ok(cube)
 }
 
 /// A cube of side `side` centred at `centre`, split into squares of side about `cell`.

@@ -1,10 +1,11 @@
 //! The core's boundary taken from the layered mesh: the top faces of the layers, the wall
 //! triangles where no layer was built, pyramids on the front's quads, and the farfield.
 
-use std::collections::HashSet;
+use std::collections::{HashMap, HashSet};
 
 use super::{farfield, ClosedBoundary, FarfieldSpec, FillError, CORE_ZONE_NAME, FARFIELD_PATCH};
 use super::{sorted_triangle, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
+use crate::layers::sliding::SymmetryPlane;
 use crate::layers::TOP_PATCH;
 use crate::mesh::{BoundaryFaces, CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
@@ -126,6 +127,61 @@ impl CoreBuild {
     /// Close the core with a farfield around the wall (patch [`FARFIELD_PATCH`]).
     pub fn add_farfield(&mut self, wall: &Surface, spec: &FarfieldSpec) -> Result<(), FillError> {
         let shell = farfield::farfield(spec, wall.bounding_box())?;
+        self.add_farfield_shell(shell);
+        Ok(())
+    }
+
+    /// Close the core of a body on a symmetry plane: a half box on the fluid's side (patch
+    /// [`FARFIELD_PATCH`]) and the rest of the plane, triangulated between the box's rim and
+    /// the core's open edges on the plane (the layers' top edges there), as `symmetry.patch`.
+    pub fn add_half_farfield(
+        &mut self,
+        wall: &Surface,
+        spec: &FarfieldSpec,
+        symmetry: &SymmetryPlane,
+    ) -> Result<(), FillError> {
+        let shell = farfield::half_box(spec, wall.bounding_box(), &symmetry.plane)?;
+        let cell = spec.cell_size.unwrap_or(super::DEFAULT_FARFIELD_CELL * wall.bounding_box().diagonal());
+        self.add_farfield_shell(shell);
+        let mut uses: HashMap<(u32, u32), u32> = HashMap::new();
+        for t in &self.faces {
+            for i in 0..3 {
+                let (a, b) = (t[i], t[(i + 1) % 3]);
+                *uses.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        let mut open: Vec<(u32, u32)> = uses.into_iter().filter(|&(_, n)| n == 1).map(|(e, _)| e).collect();
+        open.sort_unstable(); // the same mesh on every run
+        let plane = symmetry.plane;
+        let tolerance = 1e-9 * wall.bounding_box().diagonal();
+        if let Some(&(a, _)) = open.iter().find(|&&(a, b)| {
+            [a, b].iter().any(|&n| plane.signed_distance(self.mesh.points[n as usize]).abs() > tolerance)
+        }) {
+            return Err(FillError::Input(format!(
+                "the core's boundary is open at {:?}, off the symmetry plane (the layers did not end on it)",
+                self.mesh.points[a as usize].to_array()
+            )));
+        }
+        let max_area = 0.25 * 3f64.sqrt() * cell * cell;
+        let triangles = crate::layers::sliding::triangulate_region(
+            &mut self.mesh.points,
+            &open,
+            &[],
+            &plane,
+            max_area,
+        )
+        .map_err(|why| FillError::Input(format!("the symmetry plane cannot be triangulated: {why}")))?;
+        for [a, b, c] in triangles {
+            self.push([a, b, c], MARKER_WALL);
+            self.mesh.boundary.triangles.push([a, c, b]);
+            self.mesh.boundary.triangle_patch.push(symmetry.patch);
+        }
+        Ok(())
+    }
+
+    /// Add a farfield shell (facing inward) to the mesh's points, the core's boundary and the
+    /// mesh's boundary (patch [`FARFIELD_PATCH`]).
+    fn add_farfield_shell(&mut self, shell: Surface) {
         let patch = match self.mesh.patch_names.iter().position(|p| p == FARFIELD_PATCH) {
             Some(p) => p as u32,
             None => {
@@ -140,7 +196,6 @@ impl CoreBuild {
             self.mesh.boundary.triangles.push([a, c, b]);
             self.mesh.boundary.triangle_patch.push(patch);
         }
-        Ok(())
     }
 
     /// The boundary with its own compact point numbering, and the mesh node of every point.

@@ -20,6 +20,7 @@ use serde::Serialize;
 
 use crate::config::{Config, FarfieldShape, Flow};
 use crate::geometry::{triangle_area_vector, DVec3};
+use crate::layers::sliding::SymmetryPlane;
 use crate::mesh::VolumeMesh;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
@@ -308,20 +309,33 @@ pub fn fill_core(
     wall: &Surface,
     options: &CoreOptions,
 ) -> Result<(VolumeMesh, CoreStats), FillError> {
+    fill_core_on_symmetry_plane(layers, wall, options, None)
+}
+
+/// [`fill_core`] for a body on a symmetry plane (external flow): the farfield is a half box on
+/// the fluid's side of the plane, and the plane around the layers is its face
+/// ([`crate::layers::sliding::close_sliding_patches`] gives the plane).
+pub fn fill_core_on_symmetry_plane(
+    layers: &VolumeMesh,
+    wall: &Surface,
+    options: &CoreOptions,
+    symmetry: Option<&SymmetryPlane>,
+) -> Result<(VolumeMesh, CoreStats), FillError> {
     #[cfg(feature = "tetgen")]
     {
-        fill_core_with(&tetgen::TetGen::default(), layers, wall, options)
+        fill_core_with_symmetry(&tetgen::TetGen::default(), layers, wall, options, symmetry)
     }
     #[cfg(not(feature = "tetgen"))]
     {
-        let _ = (layers, wall, options);
+        let _ = (layers, wall, options, symmetry);
         Err(FillError::NoMesher)
     }
 }
 
 /// Fill the core of `layers` (built by [`crate::layers::build_layers`] from `wall` exactly as
-/// that got it: validated, and flipped for internal flow; its points are the mesh's first
-/// points) and return the whole mesh: the layer cells, the pyramids on the front
+/// that got it: validated, and flipped for internal flow; or the wall
+/// [`crate::layers::sliding::close_sliding_patches`] returns when columns slid on patches
+/// without layers; its points are the mesh's first points) and return the whole mesh: the layer cells, the pyramids on the front
 /// quads and the core tetrahedra (zone [`CORE_ZONE_NAME`]); boundary patches are the wall's and
 /// [`FARFIELD_PATCH`] (the layers' top faces are interior now).
 pub fn fill_core_with(
@@ -330,10 +344,28 @@ pub fn fill_core_with(
     wall: &Surface,
     options: &CoreOptions,
 ) -> Result<(VolumeMesh, CoreStats), FillError> {
+    fill_core_with_symmetry(mesher, layers, wall, options, None)
+}
+
+/// [`fill_core_with`] on a symmetry plane (see [`fill_core_on_symmetry_plane`]).
+pub fn fill_core_with_symmetry(
+    mesher: &dyn CoreMesher,
+    layers: &VolumeMesh,
+    wall: &Surface,
+    options: &CoreOptions,
+    symmetry: Option<&SymmetryPlane>,
+) -> Result<(VolumeMesh, CoreStats), FillError> {
     let start = Instant::now();
     let mut core = front::core_boundary(layers, wall)?;
-    if let Some(spec) = &options.farfield {
-        core.add_farfield(wall, spec)?;
+    match (&options.farfield, symmetry) {
+        (Some(spec), Some(symmetry)) => core.add_half_farfield(wall, spec, symmetry)?,
+        (Some(spec), None) => core.add_farfield(wall, spec)?,
+        (None, Some(_)) => {
+            return Err(FillError::Options(
+                "a symmetry plane the layers slid away from needs a farfield (external flow)".into(),
+            ))
+        }
+        (None, None) => {}
     }
     let (boundary, nodes) = core.closed_boundary();
     let sizing = PointSizing::mean_edge_length(&boundary);

@@ -116,7 +116,7 @@ fn collapse(plan: &mut SlabPlan, columns: &Columns, a: u32, b: u32) {
     let (keep, drop, middle) = survivor(columns, a, b);
     if middle {
         let (k, d) = (keep as usize, drop as usize);
-        plan.proposed[k] = 0.5 * (plan.proposed[k] + plan.proposed[d]);
+        plan.proposed[k] = columns.slide[k].project(0.5 * (plan.proposed[k] + plan.proposed[d]));
         let dir = (columns.dir[k] + columns.dir[d]).normalize_or(columns.dir[k]);
         plan.redirected.push((keep, dir, 0.5 * (sa + sb)));
     }

@@ -2,6 +2,7 @@
 //! faces over them (the wall triangles, plus the fan strips and corner patches of convex ridges).
 
 use crate::geometry::DVec3;
+use crate::normals::constraint::Slide;
 use crate::normals::WallNormals;
 use crate::surface::Surface;
 
@@ -24,6 +25,8 @@ pub struct Columns {
     pub wall_vertex: Vec<u32>,
     /// The column this one merged into at a collapse ([`NOT_MERGED`] if none).
     pub merged_into: Vec<u32>,
+    /// Where the column may go: its nodes are projected onto a patch plane when it slides.
+    pub slide: Vec<Slide>,
     /// For a column that ended its stack because its next cell would have been isotropic: its
     /// last layer's height over the front's tangential size then; NaN for the others.
     pub isotropic_ratio: Vec<f64>,
@@ -130,6 +133,18 @@ impl Front {
         self.index_columns(carrier.len());
     }
 
+    /// Keep only the faces of the patches `keep` accepts (before marching) and rebuild the
+    /// adjacency.
+    pub fn retain_patches(&mut self, keep: impl Fn(u32) -> bool, column_count: usize) {
+        let kept: Vec<usize> = (0..self.len()).filter(|&f| keep(self.patch[f])).collect();
+        self.columns = kept.iter().map(|&f| self.columns[f]).collect();
+        self.sizes = kept.iter().map(|&f| self.sizes[f]).collect();
+        self.patch = kept.iter().map(|&f| self.patch[f]).collect();
+        self.raised = kept.iter().map(|&f| self.raised[f]).collect();
+        self.wall_triangle = kept.iter().map(|&f| self.wall_triangle[f]).collect();
+        self.index_columns(column_count);
+    }
+
     /// The faces around column `c`.
     pub fn faces_of(&self, c: u32) -> impl Iterator<Item = usize> + '_ {
         let (lo, hi) = (self.column_face_offsets[c as usize], self.column_face_offsets[c as usize + 1]);
@@ -216,6 +231,8 @@ pub fn initial_front(surface: &Surface, normals: &WallNormals) -> (Columns, Fron
         columns.last_step.push(0.0);
         columns.max_step_ratio.push(0.0);
     }
+    columns.slide = normals.slides.clone();
+    columns.slide.resize(columns.len(), Slide::Free);
     let mut front = Front::default();
     for (t, corner_columns) in normals.triangle_columns.iter().enumerate() {
         front.push(corner_columns, surface.triangle_patch[t], Some(t as u32));

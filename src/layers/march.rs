@@ -187,9 +187,9 @@ pub fn march(
         let proposed: Vec<DVec3> = (0..columns.len())
             .into_par_iter()
             .map(|c| match (distance(c, k), distance(c, k - 1)) {
-                (Some(d), Some(d_before)) if columns.alive[c] => {
-                    points[columns.node[c] as usize] + columns.dir[c] * (columns.scale[c] * (d - d_before))
-                }
+                (Some(d), Some(d_before)) if columns.alive[c] => columns.slide[c].project(
+                    points[columns.node[c] as usize] + columns.dir[c] * (columns.scale[c] * (d - d_before)),
+                ),
                 _ => DVec3::ZERO,
             })
             .collect();

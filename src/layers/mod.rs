@@ -10,10 +10,12 @@ pub mod front;
 pub mod guard;
 pub mod march;
 pub mod slab;
+pub mod sliding;
 pub mod smoothness;
 
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
+use crate::normals::constraint::Slide;
 use crate::normals::WallNormals;
 use crate::surface::Surface;
 
@@ -48,9 +50,12 @@ pub fn build_layers(
     mut on_layer: impl FnMut(u32, u32),
 ) -> Layers {
     let (mut columns, mut front) = front::initial_front(surface, normals);
+    // The faces without layers never move: leave them out of the front.
+    let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
+    front.retain_patches(layered, columns.len());
     let column_spec = column_specs(normals, &front, patch_spec);
     for (c, spec) in column_spec.iter().enumerate() {
-        columns.alive[c] = spec.is_some();
+        columns.alive[c] = spec.is_some() && columns.slide[c] != Slide::Fixed;
     }
     let target = |c: usize| column_spec[c].map(|s| s.max_count());
     let auto: Vec<bool> = column_spec.iter().map(|s| s.is_some_and(|s| s.fixed_count().is_none())).collect();
@@ -92,7 +97,7 @@ pub fn build_layers(
 }
 
 /// The layer stack of each column: that of the first front face using it, `None` if any face
-/// using it has no layers (a column on the border of a patch without layers does not move).
+/// using it has no layers or if none does.
 fn column_specs(
     normals: &WallNormals,
     front: &front::Front,

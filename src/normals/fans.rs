@@ -70,6 +70,8 @@ pub struct WallNormals {
     /// The column of each corner of each wall triangle.
     pub triangle_columns: Vec<[u32; 3]>,
     pub fan_faces: Vec<FanFace>,
+    /// How each column may move ([`super::constraint::constrain_columns`]); empty: all free.
+    pub slides: Vec<super::constraint::Slide>,
     pub stats: NormalStats,
 }
 
@@ -97,17 +99,37 @@ fn vertex_ring(surface: &Surface, topology: &Topology, v: u32) -> Ring {
     Ring { triangles, edge_after }
 }
 
-/// Build the columns and fan faces of the wall.
+/// Build the columns and fan faces of the wall (every patch layered).
 pub fn wall_normals(
     surface: &Surface,
     topology: &Topology,
     features: &Features,
     fan_angle_deg: f64,
 ) -> WallNormals {
+    wall_normals_of_layered(surface, topology, features, fan_angle_deg, &[])
+}
+
+/// Build the columns and fan faces of the wall where patch `p` gets layers when
+/// `layered_patch[p]` (missing entries: layered). The triangles of the other patches get
+/// columns of their own (they do not move), the layered triangles' columns see only layered
+/// triangles, and only ridges between layered triangles get fans.
+pub fn wall_normals_of_layered(
+    surface: &Surface,
+    topology: &Topology,
+    features: &Features,
+    fan_angle_deg: f64,
+    layered_patch: &[bool],
+) -> WallNormals {
     let fan_angle = fan_angle_deg.to_radians();
     let mut out =
         WallNormals { triangle_columns: vec![[u32::MAX; 3]; surface.triangles.len()], ..Default::default() };
-    let is_fan_edge = |e: u32| features.edge_kind[e as usize] == EdgeKind::ConvexRidge;
+    let layered =
+        |t: u32| layered_patch.get(surface.triangle_patch[t as usize] as usize).copied().unwrap_or(true);
+    let uses_layered = |e: u32| topology.edge_uses(e).iter().map(|u| layered(u.triangle));
+    let is_fan_edge =
+        |e: u32| features.edge_kind[e as usize] == EdgeKind::ConvexRidge && uses_layered(e).all(|l| l);
+    // Sectors also end where the layered triangles end.
+    let is_cut = |e: u32| is_fan_edge(e) || (uses_layered(e).any(|l| l) && uses_layered(e).any(|l| !l));
     // Per (vertex, fan edge): the sector columns on the edge's t1 side (index 0) and t2 side.
     let mut fan_ends: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); surface.points.len()];
     for v in 0..surface.points.len() as u32 {
@@ -115,7 +137,8 @@ pub fn wall_normals(
             continue;
         }
         let ring = vertex_ring(surface, topology, v);
-        sector_columns(surface, topology, v, &ring, &is_fan_edge, &mut out, &mut fan_ends[v as usize]);
+        let cuts = (&is_cut, &is_fan_edge);
+        sector_columns(surface, topology, v, &ring, cuts, &mut out, &mut fan_ends[v as usize]);
     }
     let fan_edges: Vec<u32> = (0..topology.edge_count() as u32).filter(|&e| is_fan_edge(e)).collect();
     let segments = fan_segments(topology, &fan_edges, &fan_ends, &out.columns, fan_angle);
@@ -133,19 +156,19 @@ fn sector_columns(
     topology: &Topology,
     v: u32,
     ring: &Ring,
-    is_fan_edge: &impl Fn(u32) -> bool,
+    (is_cut, is_fan_edge): (&impl Fn(u32) -> bool, &impl Fn(u32) -> bool),
     out: &mut WallNormals,
     ends: &mut Vec<(u32, u32, u32)>,
 ) {
     let n = ring.triangles.len();
-    // Start the walk just after a fan edge, so each sector is contiguous.
-    let start = (0..n).find(|&i| is_fan_edge(ring.edge_after[i])).map_or(0, |i| (i + 1) % n);
+    // Start the walk just after a cut, so each sector is contiguous.
+    let start = (0..n).find(|&i| is_cut(ring.edge_after[i])).map_or(0, |i| (i + 1) % n);
     let mut sector: Vec<(u32, usize)> = Vec::new();
     let mut sector_col_of_ring = vec![0u32; n];
     for step in 0..n {
         let i = (start + step) % n;
         sector.push(ring.triangles[i]);
-        if is_fan_edge(ring.edge_after[i]) || step == n - 1 {
+        if is_cut(ring.edge_after[i]) || step == n - 1 {
             let col = push_sector_column(surface, v, &sector, out);
             for k in 0..sector.len() {
                 sector_col_of_ring[(i + n - k) % n] = col;
