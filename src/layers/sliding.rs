@@ -47,7 +47,8 @@ pub fn close_sliding_patches(
     planes: &[Option<Plane>],
     symmetry_patch: &[bool],
 ) -> Result<Closed, SlidingError> {
-    let free = free_faces(mesh);
+    // Without a planar patch to slide on, every layer face is on the wall or the top.
+    let free = if planes.iter().all(Option::is_none) { Vec::new() } else { free_faces(mesh) };
     if free.is_empty() {
         return Ok(Closed { core_wall: wall.clone(), symmetry: Vec::new() });
     }
