@@ -53,7 +53,8 @@ pub fn build_layers(
     // The faces without layers never move: leave them out of the front.
     let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
     front.retain_patches(layered, columns.len());
-    let column_spec = column_specs(normals, &front, patch_spec);
+    let mut column_spec = column_specs(normals, &front, patch_spec);
+    grade_first_heights(surface, &columns, &mut column_spec);
     for (c, spec) in column_spec.iter().enumerate() {
         columns.alive[c] = spec.is_some() && columns.slide[c] != Slide::Fixed;
     }
@@ -116,6 +117,63 @@ fn column_specs(
         }
     }
     spec.into_iter().map(Option::flatten).collect()
+}
+
+/// Where patches with different first heights meet, lower the larger ones near the border so
+/// that neighbouring wall vertices' first heights (and with equal counts and growth, their
+/// stack thicknesses) differ by at most the growth ratio: no step in the layers at a patch
+/// border. A graded minimum over the wall's edges, by Dijkstra's order; heights only go down
+/// (a finer first cell is always allowed).
+fn grade_first_heights(surface: &Surface, columns: &front::Columns, column_spec: &mut [Option<LayerSpec>]) {
+    let n = surface.points.len();
+    let mut height = vec![f64::INFINITY; n];
+    let mut growth = vec![f64::INFINITY; n];
+    for (c, spec) in column_spec.iter().enumerate() {
+        if let Some(s) = spec {
+            let v = columns.wall_vertex[c] as usize;
+            height[v] = height[v].min(s.first_height);
+            growth[v] = growth[v].min(s.growth);
+        }
+    }
+    let distinct = column_spec
+        .iter()
+        .flatten()
+        .map(|s| s.first_height.to_bits())
+        .collect::<std::collections::BTreeSet<_>>();
+    if distinct.len() < 2 {
+        return;
+    }
+    let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); n];
+    for t in &surface.triangles {
+        for i in 0..3 {
+            let (a, b) = (t[i], t[(i + 1) % 3]);
+            neighbours[a as usize].push(b);
+        }
+    }
+    // Dijkstra on the multiplicative metric: settle the smallest height first.
+    let mut heap: std::collections::BinaryHeap<std::cmp::Reverse<(u64, u32)>> = (0..n as u32)
+        .filter(|&v| height[v as usize].is_finite())
+        .map(|v| std::cmp::Reverse((height[v as usize].to_bits(), v)))
+        .collect();
+    while let Some(std::cmp::Reverse((bits, v))) = heap.pop() {
+        let h = f64::from_bits(bits);
+        if h > height[v as usize] {
+            continue;
+        }
+        for &w in &neighbours[v as usize] {
+            let w = w as usize;
+            let limit = h * growth[w].min(growth[v as usize]);
+            if height[w].is_finite() && limit < height[w] {
+                height[w] = limit;
+                heap.push(std::cmp::Reverse((limit.to_bits(), w as u32)));
+            }
+        }
+    }
+    for (c, spec) in column_spec.iter_mut().enumerate() {
+        if let Some(s) = spec {
+            s.first_height = s.first_height.min(height[columns.wall_vertex[c] as usize]);
+        }
+    }
 }
 
 /// Boundary faces of the layered mesh: the wall triangles with a cell on them (oriented out of
