@@ -143,10 +143,26 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {e:#}");
+            eprintln!("error: {}", error_message(&e));
             ExitCode::from(EXIT_FAILURE)
         }
     }
+}
+
+/// The error and its causes, each once: our error types already print their source in their own
+/// message, which `{:#}` would repeat.
+fn error_message(e: &anyhow::Error) -> String {
+    let mut message = String::new();
+    for cause in e.chain() {
+        let text = cause.to_string();
+        if !message.contains(&text) {
+            if !message.is_empty() {
+                message.push_str(": ");
+            }
+            message.push_str(&text);
+        }
+    }
+    message
 }
 
 fn init_logging(verbose: u8) {
@@ -288,4 +304,20 @@ fn print_out(text: &str) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     let _ = writeln!(out, "{text}").and_then(|()| out.flush());
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A cause that the message above already quotes is not repeated; a new one is added.
+    #[test]
+    fn error_message_names_each_cause_once() {
+        let read = crate::io::read_surface(Path::new("/nonexistent/x.stl")).unwrap_err();
+        let quoted = read.to_string();
+        let e = anyhow::Error::new(read);
+        assert_eq!(error_message(&e), quoted);
+        let e = e.context("meshing failed");
+        assert_eq!(error_message(&e), format!("meshing failed: {quoted}"));
+    }
 }

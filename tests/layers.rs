@@ -184,7 +184,8 @@ fn patch_settings_meet_without_steps() {
          [[patch]]\nmatch = \"cap\"\nfirst_height = 0.005\n",
     )
     .expect("a valid config");
-    let out = run(surface, &config, &MeshOptions { core: false }, Progress::hidden()).expect("meshing succeeds");
+    let out =
+        run(surface, &config, &MeshOptions { core: false }, Progress::hidden()).expect("meshing succeeds");
     assert!(out.report.check.is_valid(), "{}", out.report.check);
     let ratio = &out.report.layers.smoothness.neighbour_thickness_ratio;
     // Thickness is measured as the distance from the wall vertex to its top node, which curved

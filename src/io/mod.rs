@@ -250,7 +250,13 @@ fn replace_through_temporary(
         Some(d) if !d.as_os_str().is_empty() => d,
         _ => Path::new("."),
     };
-    let mut tmp = tempfile::Builder::new().prefix(".blmesh-").tempfile_in(dir)?;
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".blmesh-");
+    // A temporary is private (0600); the output should get the mode any new file gets (0666
+    // less the umask).
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    let mut tmp = builder.tempfile_in(dir)?;
     fill(&mut tmp)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
@@ -260,6 +266,19 @@ fn replace_through_temporary(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// An atomically written output gets the same mode as a file created the ordinary way.
+    #[cfg(unix)]
+    #[test]
+    fn atomic_output_has_the_usual_mode() {
+        use std::os::unix::fs::PermissionsExt;
+        let dir = tempfile::tempdir().unwrap();
+        let (ours, plain) = (dir.path().join("ours.txt"), dir.path().join("plain.txt"));
+        write_atomic(&ours, |w| w.write_all(b"x")).unwrap();
+        std::fs::write(&plain, b"x").unwrap();
+        let mode = |p: &Path| std::fs::metadata(p).unwrap().permissions().mode() & 0o777;
+        assert_eq!(mode(&ours), mode(&plain));
+    }
 
     #[test]
     fn atomic_write_leaves_nothing_on_failure() {
