@@ -177,10 +177,20 @@ pub fn run(
     };
     let layer_summary = layer_summary(&layered, &surface, &features);
     let (mesh, core) = if options.core {
-        let (mesh, stats) = timings.time("core", || {
+        let (mesh, mut stats) = timings.time("core", || {
             let options = CoreOptions::from_config(config);
             fill_core_on_symmetry_plane(&layered.mesh, &closed.core_wall, &options, symmetry)
         })?;
+        let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
+        let core_zone = mesh.zone_names.iter().position(|z| z == crate::fill::CORE_ZONE_NAME);
+        if let Some(core_zone) = core_zone {
+            stats.size_jump = crate::fill::size_jump::measure(
+                &mesh,
+                crate::layers::march::LAYER_ZONE,
+                core_zone as u32,
+                growth,
+            );
+        }
         (mesh, Some(stats))
     } else {
         (std::mem::take(&mut layered.mesh), None)
@@ -363,6 +373,17 @@ impl std::fmt::Display for MeshReport {
                     s.count, s.threshold, s.boundary_angle, s.boundary_triangle, s.thin_gap, s.not_forced, s.all_nodes_on_boundary
                 )?;
                 writeln!(f, "          min dihedral per tetrahedron (deg): {}", q.histogram)?;
+                let j = &c.size_jump;
+                let bins: Vec<String> =
+                    j.histogram.iter().map(|(label, n)| format!("{label}: {n}")).collect();
+                writeln!(
+                    f,
+                    "size jump first core tet over last layer height at {} front triangles: median {:.2}, within [1/r, r] at {:.1}%; {}",
+                    j.stats.count,
+                    j.stats.median,
+                    100.0 * j.stats.within_band,
+                    bins.join(", ")
+                )?;
             }
             None => {
                 writeln!(f, "core      not built (--no-core): the layers' top faces are the patch bl_top")?

@@ -11,6 +11,7 @@ pub mod farfield;
 mod front;
 pub mod improve;
 mod merge;
+pub mod size_jump;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;
 
@@ -298,6 +299,9 @@ pub struct CoreStats {
     pub max_dihedral: f64,
     /// The dihedral angles before and after our improvement, and what is left below 10 degrees.
     pub quality: improve::CoreQuality,
+    /// First core tetrahedron's height over the last layer's, over the front triangles (set by
+    /// the pipeline, which knows the growth ratio).
+    pub size_jump: size_jump::SizeJump,
     /// Wall-clock time of the whole fill and of the mesher alone, seconds.
     pub seconds: f64,
     pub mesher_seconds: f64,

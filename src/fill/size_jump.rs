@@ -1,0 +1,114 @@
+//! The size jump at the top of the layers (issue 5): over every front triangle, the height of
+//! the core tetrahedron on it (its fourth node's distance from the triangle's plane) over the
+//! height of the last layer's prism under it. A smooth transition keeps the ratio within
+//! [1/r, r]; an isotropic core on thin last layers gives ratios far above r.
+
+use std::collections::HashMap;
+
+use serde::Serialize;
+
+use crate::layers::smoothness::RatioStats;
+use crate::mesh::{CellKind, VolumeMesh};
+use crate::quality::validity::gather;
+
+/// The size-jump ratios and their histogram.
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct SizeJump {
+    /// Within the band [1/r, r].
+    pub stats: RatioStats,
+    /// Counts per bin, the bins bounded by powers of r: (label, count).
+    pub histogram: Vec<(String, usize)>,
+}
+
+/// Upper bounds of the histogram bins, as powers of the growth ratio.
+const BIN_POWERS: [i32; 6] = [-2, -1, 1, 2, 4, 8];
+
+/// The ratios over the front triangles, in `mesh` (the merged mesh: layer cells in zone
+/// `layer_zone`, core tetrahedra in `core_zone`), with the band [1/growth, growth].
+pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) -> SizeJump {
+    let key = |mut t: [u32; 3]| {
+        t.sort_unstable();
+        t
+    };
+    let tets = mesh.block(CellKind::Tetrahedron);
+    let core_tets =
+        || tets.nodes.chunks_exact(4).zip(&tets.zone).filter(move |(_, &z)| z == core_zone).map(|(c, _)| c);
+    // Only the prisms whose top touches the core can be under a front triangle.
+    let mut in_core = vec![false; mesh.points.len()];
+    for t in core_tets() {
+        for &n in t {
+            in_core[n as usize] = true;
+        }
+    }
+    let prisms = mesh.block(CellKind::Prism);
+    let mut last_height: HashMap<[u32; 3], f64> = HashMap::new();
+    for (p, &zone) in prisms.nodes.chunks_exact(6).zip(&prisms.zone) {
+        let top = [p[3], p[4], p[5]];
+        if zone == layer_zone && top.iter().all(|&n| in_core[n as usize]) {
+            let x = |n: u32| mesh.points[n as usize];
+            // The prism's volume over its top's area (exact for a right prism).
+            let Some(corners) = gather(&mesh.points, p) else { continue };
+            let volume = crate::quality::measures::volume(CellKind::Prism, &corners);
+            let area = (x(top[1]) - x(top[0])).cross(x(top[2]) - x(top[0])).length() / 2.0;
+            if area > 0.0 {
+                last_height.insert(key(top), volume / area);
+            }
+        }
+    }
+    let mut ratios = Vec::new();
+    for t in core_tets() {
+        for skip in 0..4 {
+            let face: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
+            if let Some(&h) = last_height.get(&key([face[0], face[1], face[2]])) {
+                let x = |n: u32| mesh.points[n as usize];
+                let normal = (x(face[1]) - x(face[0])).cross(x(face[2]) - x(face[0])).normalize_or_zero();
+                let height = (x(t[skip]) - x(face[0])).dot(normal).abs();
+                ratios.push(height / h);
+            }
+        }
+    }
+    SizeJump { histogram: histogram(&ratios, growth), stats: RatioStats::of(ratios, 1.0 / growth, growth) }
+}
+
+fn histogram(ratios: &[f64], growth: f64) -> Vec<(String, usize)> {
+    let mut counts = vec![0usize; BIN_POWERS.len() + 1];
+    for &q in ratios {
+        let bin = BIN_POWERS.iter().position(|&k| q <= growth.powi(k)).unwrap_or(BIN_POWERS.len());
+        counts[bin] += 1;
+    }
+    let mut labels: Vec<String> = BIN_POWERS.iter().map(|k| format!("<= r^{k}")).collect();
+    labels.push(format!("> r^{}", BIN_POWERS[BIN_POWERS.len() - 1]));
+    labels.into_iter().zip(counts).collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::geometry::DVec3;
+
+    /// A prism of height 0.5 under a tetrahedron of height 1.5 on its top: ratio 3, outside
+    /// the band for r = 1.2 and in the bin (r^4, r^8].
+    #[test]
+    fn ratio_of_a_tet_on_a_prism() {
+        let mut mesh = VolumeMesh {
+            points: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(0.0, 0.0, 0.5),
+                DVec3::new(1.0, 0.0, 0.5),
+                DVec3::new(0.0, 1.0, 0.5),
+                DVec3::new(0.3, 0.3, 2.0),
+            ],
+            zone_names: vec!["layers".into(), "core".into()],
+            ..Default::default()
+        };
+        mesh.push_cell(CellKind::Prism, &[0, 1, 2, 3, 4, 5], 0);
+        mesh.push_cell(CellKind::Tetrahedron, &[3, 4, 5, 6], 1);
+        let jump = measure(&mesh, 0, 1, 1.2);
+        assert_eq!(jump.stats.count, 1);
+        assert!((jump.stats.median - 3.0).abs() < 1e-12, "{:?}", jump.stats);
+        assert_eq!(jump.stats.within_band, 0.0);
+        assert_eq!(jump.histogram[5].1, 1, "{:?}", jump.histogram);
+    }
+}
