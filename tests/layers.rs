@@ -191,5 +191,9 @@ fn patch_settings_meet_without_steps() {
     // Thickness is measured as the distance from the wall vertex to its top node, which curved
     // fronts bend by a little: 1% slack. Without the grading p95 is 2.0 (the cap against the body).
     assert!(ratio.p95 <= GROWTH * 1.01, "{ratio:?}");
+    // At the patch borders themselves (edges with an end on one), where the settings meet: within
+    // one growth ratio at 90% and more (the rest where columns stop at the fin-body junction).
+    let border = &out.report.layers.smoothness.patch_border_thickness_ratio;
+    assert!(border.count > 1000 && border.within_band >= 0.9, "{border:?}");
     assert!(out.report.layers.full_coverage >= 0.95, "{}", out.report.layers.full_coverage);
 }

@@ -119,6 +119,9 @@ fn column_specs(
     spec.into_iter().map(Option::flatten).collect()
 }
 
+/// The share of the growth ratio (as an exponent) that neighbouring first heights may differ by.
+const GRADING_SHARE: f64 = 0.9;
+
 /// Where patches with different first heights meet, lower the larger ones near the border so
 /// that neighbouring wall vertices' first heights (and with equal counts and growth, their
 /// stack thicknesses) differ by at most the growth ratio: no step in the layers at a patch
@@ -162,7 +165,8 @@ fn grade_first_heights(surface: &Surface, columns: &front::Columns, column_spec:
         }
         for &w in &neighbours[v as usize] {
             let w = w as usize;
-            let limit = h * growth[w].min(growth[v as usize]);
+            // A little under r: the thickness of curved fronts varies a little more than h0.
+            let limit = h * growth[w].min(growth[v as usize]).powf(GRADING_SHARE);
             if height[w].is_finite() && limit < height[w] {
                 height[w] = limit;
                 heap.push(std::cmp::Reverse((limit.to_bits(), w as u32)));

@@ -5,8 +5,11 @@
 
 use serde::Serialize;
 
+use rayon::prelude::*;
+
 use super::front::Columns;
 use crate::mesh::VolumeMesh;
+use crate::sizing::wall::WallDistance;
 use crate::surface::Surface;
 
 /// A distribution of ratios: quantiles, the largest, and the fraction within a tolerance band.
@@ -46,6 +49,9 @@ pub struct Smoothness {
     /// Over the wall edges whose two vertices have layers: the larger final thickness over the
     /// smaller (band [1, r]).
     pub neighbour_thickness_ratio: RatioStats,
+    /// The same over the wall edges with an end on a patch border (where per-patch settings
+    /// meet).
+    pub patch_border_thickness_ratio: RatioStats,
     /// Over the columns: the largest ratio of a layer's height to the one below it (band
     /// [1/r, r]; merged columns are re-aimed, which changes their step).
     pub layer_height_ratio: RatioStats,
@@ -66,32 +72,60 @@ pub fn measure(surface: &Surface, mesh: &VolumeMesh, columns: &Columns, growth: 
         .collect();
     edges.sort_unstable();
     edges.dedup();
-    let neighbour: Vec<f64> = edges
-        .iter()
-        .filter_map(|e| {
-            let (a, b) = (thickness[e[0] as usize]?, thickness[e[1] as usize]?);
-            (a.min(b) > 0.0).then(|| a.max(b) / a.min(b))
-        })
-        .collect();
+    let ratio = |e: &[u32; 2]| {
+        let (a, b) = (thickness[e[0] as usize]?, thickness[e[1] as usize]?);
+        (a.min(b) > 0.0).then(|| a.max(b) / a.min(b))
+    };
+    let neighbour: Vec<f64> = edges.iter().filter_map(ratio).collect();
+    let border = patch_border_vertices(surface);
+    let at_border: Vec<f64> =
+        edges.iter().filter(|e| border[e[0] as usize] || border[e[1] as usize]).filter_map(ratio).collect();
     let steps: Vec<f64> =
         (0..columns.len()).map(|c| columns.max_step_ratio[c]).filter(|&r| r > 0.0).collect();
     let isotropy: Vec<f64> = columns.isotropic_ratio.iter().copied().filter(|r| !r.is_nan()).collect();
     Smoothness {
         neighbour_thickness_ratio: RatioStats::of(neighbour, 1.0, growth * (1.0 + 1e-9)),
+        patch_border_thickness_ratio: RatioStats::of(at_border, 1.0, growth * (1.0 + 1e-9)),
         layer_height_ratio: RatioStats::of(steps, 1.0 / growth - 1e-9, growth * (1.0 + 1e-9)),
         isotropy_ratio: RatioStats::of(isotropy, 1.0 / growth, growth),
     }
 }
 
+/// The vertices whose triangles are in more than one patch.
+fn patch_border_vertices(surface: &Surface) -> Vec<bool> {
+    let mut first = vec![u32::MAX; surface.points.len()];
+    let mut border = vec![false; surface.points.len()];
+    for (t, &patch) in surface.triangles.iter().zip(&surface.triangle_patch) {
+        for &v in t {
+            let f = &mut first[v as usize];
+            if *f == u32::MAX {
+                *f = patch;
+            } else if *f != patch {
+                border[v as usize] = true;
+            }
+        }
+    }
+    border
+}
+
 /// Final thickness at every wall vertex with layers: the largest distance from it to the top of
 /// one of its columns (followed through merges).
 fn vertex_thickness(surface: &Surface, mesh: &VolumeMesh, columns: &Columns) -> Vec<Option<f64>> {
+    // The exact wall distance of the top: a concave ridge column travels d / sin(phi/2) along
+    // its bisector but ends at wall distance d, like its neighbours.
+    let wall = WallDistance::new(surface);
+    let distance: Vec<Option<f64>> = (0..columns.len())
+        .into_par_iter()
+        .map(|c| {
+            let carrier = columns.carrier(c);
+            let top = mesh.points[columns.node[carrier] as usize];
+            (columns.layers[carrier] > 0).then(|| wall.closest(top).map_or(0.0, |w| w.distance))
+        })
+        .collect();
     let mut thickness: Vec<Option<f64>> = vec![None; surface.points.len()];
-    for c in 0..columns.len() {
-        let top = mesh.points[columns.node[columns.carrier(c)] as usize];
+    for (c, t) in distance.into_iter().enumerate() {
         let v = columns.wall_vertex[c] as usize;
-        if columns.layers[columns.carrier(c)] > 0 {
-            let t = top.distance(surface.points[v]);
+        if let Some(t) = t {
             thickness[v] = Some(thickness[v].map_or(t, |x: f64| x.max(t)));
         }
     }
