@@ -237,7 +237,7 @@ fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
             .with_context(|| format!("{}: cannot write", report_path.display()))?;
     }
     if let Some(dir) = &args.pictures {
-        crate::picture::write_overview(&out.mesh, dir)
+        crate::picture::write_overview(&out.mesh, dir, &out.report.picture_spots)
             .with_context(|| format!("{}: cannot write the pictures", dir.display()))?;
     }
     if !quiet {

@@ -62,6 +62,9 @@ pub struct MeshReport {
     /// Peak resident memory of the run, in MiB (Linux only).
     pub peak_memory_mib: Option<f64>,
     pub warnings: Vec<String>,
+    /// Where `--pictures` cuts the mesh besides the overview: the most concave ridge edge and a
+    /// convex corner.
+    pub picture_spots: Vec<crate::picture::PictureSpot>,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -214,9 +217,54 @@ pub fn run(
         check,
         timings,
         peak_memory_mib: crate::progress::peak_memory_mib(),
+        picture_spots: picture_spots(&surface, &topology, &features, &patch_spec),
         warnings,
     };
     Ok(MeshOutput { mesh, report })
+}
+
+/// Cuts for the pictures: across the most concave ridge edge (normal along it, through its
+/// middle) and through the convex corner with the sharpest ridge (normal along that ridge), each
+/// zoomed to four layer thicknesses or two edge lengths, whichever is larger.
+fn picture_spots(
+    surface: &Surface,
+    topology: &Topology,
+    features: &Features,
+    patch_spec: &[Option<LayerSpec>],
+) -> Vec<crate::picture::PictureSpot> {
+    use crate::picture::PictureSpot;
+    use crate::surface::features::{EdgeKind, VertexKind};
+    let thickness = patch_spec.iter().flatten().map(|s| s.distance(s.max_count())).fold(0.0, f64::max);
+    let edge = |e: usize| topology.edges[e].map(|v| surface.points[v as usize]);
+    let spot = |name: &str, origin: crate::geometry::DVec3, along: [crate::geometry::DVec3; 2]| PictureSpot {
+        name: name.to_owned(),
+        origin,
+        normal: (along[1] - along[0]).normalize_or(crate::geometry::DVec3::Z),
+        half_width: (4.0 * thickness).max(2.0 * along[0].distance(along[1])),
+    };
+    let mut spots = Vec::new();
+    let ridges =
+        |kind: EdgeKind| (0..features.edge_kind.len()).filter(move |&e| features.edge_kind[e] == kind);
+    if let Some(e) =
+        ridges(EdgeKind::ConcaveRidge).min_by(|&a, &b| features.turn_deg[a].total_cmp(&features.turn_deg[b]))
+    {
+        let [a, b] = edge(e);
+        spots.push(spot("concave_ridge", 0.5 * (a + b), [a, b]));
+    }
+    let at_convex_corner = |e: &usize| {
+        topology.edges[*e].iter().any(|&v| features.vertex_kind[v as usize] == VertexKind::ConvexCorner)
+    };
+    if let Some(e) = ridges(EdgeKind::ConvexRidge)
+        .filter(at_convex_corner)
+        .max_by(|&a, &b| features.turn_deg[a].total_cmp(&features.turn_deg[b]))
+    {
+        let [a, b] = topology.edges[e];
+        let (corner, other) =
+            if features.vertex_kind[a as usize] == VertexKind::ConvexCorner { (a, b) } else { (b, a) };
+        let (corner, other) = (surface.points[corner as usize], surface.points[other as usize]);
+        spots.push(spot("convex_corner", corner, [corner, other]));
+    }
+    spots
 }
 
 /// The resolved layer stack of every patch (`None`: no layers on it).

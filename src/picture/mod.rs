@@ -15,7 +15,7 @@ use std::path::Path;
 pub use colour::{kind_colour, quality_colour, Colouring};
 pub use cut::{cut_picture, CutPlane, View};
 pub use histogram::{histogram, histogram_picture};
-pub use overview::{scaled_jacobians, write_overview};
+pub use overview::{scaled_jacobians, write_overview, PictureSpot};
 pub use tiny_skia::Pixmap;
 
 /// Write a picture as a PNG file, atomically (a failure leaves no file).

@@ -26,6 +26,16 @@ pub fn scaled_jacobians(mesh: &VolumeMesh) -> Vec<f64> {
     mesh.blocks.iter().flat_map(per_block).collect()
 }
 
+/// A named place to cut the mesh at (a concave ridge, a convex corner), with the half width of
+/// the view around it.
+#[derive(Clone, Debug, serde::Serialize)]
+pub struct PictureSpot {
+    pub name: String,
+    pub origin: DVec3,
+    pub normal: DVec3,
+    pub half_width: f64,
+}
+
 /// Write the standard pictures of `mesh` into `dir` (created if missing) and return their paths:
 /// - `cut_x.png`, `cut_y.png`, `cut_z.png`: cuts through the centre of the mesh's bounding box
 ///   normal to each axis, the whole cut in view, cells coloured by kind; `cut_*_quality.png`
@@ -33,8 +43,9 @@ pub fn scaled_jacobians(mesh: &VolumeMesh) -> Vec<f64> {
 /// - `worst_cell.png`, `worst_cell_quality.png`: a cut z = const through the centroid of the
 ///   cell of lowest scaled Jacobian, zoomed on its neighbourhood (4 times its size);
 /// - `quality_histogram.png`: the scaled Jacobians of all cells in 50 bins over [0, 1]
-///   (invalid cells, <= 0, in the first bin).
-pub fn write_overview(mesh: &VolumeMesh, dir: &Path) -> std::io::Result<Vec<PathBuf>> {
+///   (invalid cells, <= 0, in the first bin);
+/// - `NAME.png`, `NAME_quality.png` for every spot: the cut through it, zoomed to its width.
+pub fn write_overview(mesh: &VolumeMesh, dir: &Path, spots: &[PictureSpot]) -> std::io::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)?;
     let mut written = Vec::new();
     let mut write = |name: &str, picture: &tiny_skia::Pixmap| {
@@ -50,6 +61,13 @@ pub fn write_overview(mesh: &VolumeMesh, dir: &Path) -> std::io::Result<Vec<Path
         write(&format!("cut_{axis}.png"), &cut_picture(mesh, &plane, &view, Colouring::Kind, SIDE, SIDE))?;
         let quality = cut_picture(mesh, &plane, &view, Colouring::Quality, SIDE, SIDE);
         write(&format!("cut_{axis}_quality.png"), &quality)?;
+    }
+    for spot in spots {
+        let plane = CutPlane { origin: spot.origin, normal: spot.normal };
+        let view = View::around(spot.origin, spot.half_width);
+        write(&format!("{}.png", spot.name), &cut_picture(mesh, &plane, &view, Colouring::Kind, SIDE, SIDE))?;
+        let quality = cut_picture(mesh, &plane, &view, Colouring::Quality, SIDE, SIDE);
+        write(&format!("{}_quality.png", spot.name), &quality)?;
     }
     let quality = scaled_jacobians(mesh);
     if let Some((plane, view)) = worst_cell_view(mesh, &quality) {
@@ -85,11 +103,15 @@ mod tests {
         let dir = tempfile::tempdir().unwrap();
         let mut mesh = hybrid_column();
         mesh.points[5].x += 0.3; // the worst cell is then next to node 5
-        let written = write_overview(&mesh, &dir.path().join("pictures")).unwrap();
+        let centre = Aabb::from_points(&mesh.points).center();
+        let spot = PictureSpot { name: "spot".into(), origin: centre, normal: DVec3::X, half_width: 1.0 };
+        let written = write_overview(&mesh, &dir.path().join("pictures"), &[spot]).unwrap();
         let names: Vec<_> =
             written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
-        assert_eq!(names.len(), 9, "{names:?}");
-        assert!(names.contains(&"worst_cell.png".to_string()));
+        assert_eq!(names.len(), 11, "{names:?}");
+        assert!(
+            names.contains(&"worst_cell.png".to_string()) && names.contains(&"spot_quality.png".to_string())
+        );
         for path in &written {
             let picture = tiny_skia::Pixmap::load_png(path).unwrap();
             assert!(picture.pixels().iter().any(|p| p.red() != 255), "{} is blank", path.display());
