@@ -73,7 +73,14 @@ pub fn build_layers(
     });
     add_boundary(&mut mesh, surface, &front, &columns);
     let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
-    let smoothness = smoothness::measure(surface, &mesh, &columns, growth);
+    let reached: Vec<Option<f64>> = (0..columns.len())
+        .map(|c| {
+            let carrier = columns.carrier(c);
+            let layers = columns.layers[carrier];
+            (layers > 0).then(|| distance(carrier, layers)).flatten()
+        })
+        .collect();
+    let smoothness = smoothness::measure(surface, &columns, &reached, growth);
     let mut vertex_layers: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut vertex_target: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut stopped_vertices = Vec::new();

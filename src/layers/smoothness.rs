@@ -5,11 +5,7 @@
 
 use serde::Serialize;
 
-use rayon::prelude::*;
-
 use super::front::Columns;
-use crate::mesh::VolumeMesh;
-use crate::sizing::wall::WallDistance;
 use crate::surface::Surface;
 
 /// A distribution of ratios: quantiles, the largest, and the fraction within a tolerance band.
@@ -61,9 +57,12 @@ pub struct Smoothness {
     pub isotropy_ratio: RatioStats,
 }
 
-/// Measure the layers' smoothness. `growth` is the (largest) growth ratio, for the bands.
-pub fn measure(surface: &Surface, mesh: &VolumeMesh, columns: &Columns, growth: f64) -> Smoothness {
-    let thickness = vertex_thickness(surface, mesh, columns);
+/// Measure the layers' smoothness. `reached[c]` is the wall distance column `c`'s stack reached
+/// (`None` without layers): the march puts every top at its stack's distance from the wall (a
+/// bisector column too, not its longer path along the bisector). `growth` is the (largest)
+/// growth ratio, for the bands.
+pub fn measure(surface: &Surface, columns: &Columns, reached: &[Option<f64>], growth: f64) -> Smoothness {
+    let thickness = vertex_thickness(surface, columns, reached);
     let mut edges: Vec<[u32; 2]> = surface
         .triangles
         .iter()
@@ -108,24 +107,13 @@ fn patch_border_vertices(surface: &Surface) -> Vec<bool> {
     border
 }
 
-/// Final thickness at every wall vertex with layers: the largest distance from it to the top of
-/// one of its columns (followed through merges).
-fn vertex_thickness(surface: &Surface, mesh: &VolumeMesh, columns: &Columns) -> Vec<Option<f64>> {
-    // The exact wall distance of the top: a concave ridge column travels d / sin(phi/2) along
-    // its bisector but ends at wall distance d, like its neighbours.
-    let wall = WallDistance::new(surface);
-    let distance: Vec<Option<f64>> = (0..columns.len())
-        .into_par_iter()
-        .map(|c| {
-            let carrier = columns.carrier(c);
-            let top = mesh.points[columns.node[carrier] as usize];
-            (columns.layers[carrier] > 0).then(|| wall.closest(top).map_or(0.0, |w| w.distance))
-        })
-        .collect();
+/// Final thickness at every wall vertex with layers: the largest over its columns of the wall
+/// distance the column (or the bisector column it merged into) reached, `reached[c]`.
+fn vertex_thickness(surface: &Surface, columns: &Columns, reached: &[Option<f64>]) -> Vec<Option<f64>> {
     let mut thickness: Vec<Option<f64>> = vec![None; surface.points.len()];
-    for (c, t) in distance.into_iter().enumerate() {
+    for (c, t) in reached.iter().enumerate() {
         let v = columns.wall_vertex[c] as usize;
-        if let Some(t) = t {
+        if let Some(t) = *t {
             thickness[v] = Some(thickness[v].map_or(t, |x: f64| x.max(t)));
         }
     }
