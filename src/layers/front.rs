@@ -48,6 +48,11 @@ impl Columns {
         self.base.is_empty()
     }
 
+    /// One more than the largest wall vertex of any column (a size for per-vertex arrays).
+    pub fn wall_vertex_count(&self) -> usize {
+        self.wall_vertex.iter().max().map_or(0, |&v| v as usize + 1)
+    }
+
     /// The column that carries `c` on: itself, or the last one of its chain of merges.
     pub fn carrier(&self, mut c: usize) -> usize {
         while self.merged_into[c] != NOT_MERGED {
@@ -185,24 +190,29 @@ impl Front {
     /// webs included, get the size of the front along the wall. An edge inside the front counts
     /// once from each face.
     pub fn mean_edge_length_at_columns(&self, points: &[DVec3], columns: &Columns) -> Vec<f64> {
-        let vertices = columns.wall_vertex.iter().max().map_or(0, |&v| v as usize + 1);
+        let vertices = columns.wall_vertex_count();
         let mut sum = vec![0.0; vertices];
         let mut count = vec![0u32; vertices];
-        for face in 0..self.len() {
-            let cols = self.face_columns(face);
-            for i in 0..cols.len() {
-                let (a, b) = (cols[i] as usize, cols[(i + 1) % cols.len()] as usize);
-                let (va, vb) = (columns.wall_vertex[a] as usize, columns.wall_vertex[b] as usize);
-                let length = points[columns.node[a] as usize].distance(points[columns.node[b] as usize]);
-                if length > 0.0 && va != vb {
-                    for v in [va, vb] {
-                        sum[v] += length;
-                        count[v] += 1;
-                    }
+        for (a, b) in self.edges() {
+            let (va, vb) = (columns.wall_vertex[a] as usize, columns.wall_vertex[b] as usize);
+            let length = points[columns.node[a] as usize].distance(points[columns.node[b] as usize]);
+            if length > 0.0 && va != vb {
+                for v in [va, vb] {
+                    sum[v] += length;
+                    count[v] += 1;
                 }
             }
         }
         columns.wall_vertex.iter().map(|&v| sum[v as usize] / count[v as usize] as f64).collect()
+    }
+
+    /// The edges `(a, b)` of every face, as column indices (an edge inside the front comes once
+    /// from each of its faces).
+    pub fn edges(&self) -> impl Iterator<Item = (usize, usize)> + '_ {
+        (0..self.len()).flat_map(move |f| {
+            let cols = self.face_columns(f);
+            (0..cols.len()).map(move |i| (cols[i] as usize, cols[(i + 1) % cols.len()] as usize))
+        })
     }
 
     /// The faces touching any of `columns`, each once.

@@ -236,7 +236,7 @@ fn stop_isotropic_columns(
         (0..columns.len()).map(|c| columns.alive[c] && stop_when_isotropic[c]).collect();
     // The columns of one wall vertex (a fan) end together: a fan strip cell with one side
     // stopped and the other moving would be flat.
-    let mut vertex_ends = vec![false; columns.wall_vertex.iter().max().map_or(0, |&v| v as usize + 1)];
+    let mut vertex_ends = vec![false; columns.wall_vertex_count()];
     for c in (0..columns.len()).filter(|&c| candidates[c] && ends(c)) {
         vertex_ends[columns.wall_vertex[c] as usize] = true;
     }
@@ -255,14 +255,10 @@ fn stop_isotropic_columns(
 /// isotropy (`u32::MAX` if none).
 fn ended_neighbour_layers(columns: &Columns, front: &Front) -> Vec<u32> {
     let mut fewest = vec![u32::MAX; columns.len()];
-    for f in 0..front.len() {
-        let cols = front.face_columns(f);
-        for i in 0..cols.len() {
-            let (a, b) = (cols[i] as usize, cols[(i + 1) % cols.len()] as usize);
-            for (c, n) in [(a, b), (b, a)] {
-                if !columns.isotropic_ratio[n].is_nan() {
-                    fewest[c] = fewest[c].min(columns.layers[n]);
-                }
+    for (a, b) in front.edges() {
+        for (c, n) in [(a, b), (b, a)] {
+            if !columns.isotropic_ratio[n].is_nan() {
+                fewest[c] = fewest[c].min(columns.layers[n]);
             }
         }
     }
