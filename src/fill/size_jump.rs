@@ -7,6 +7,7 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
+use crate::geometry::triangle_area_vector;
 use crate::layers::smoothness::RatioStats;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::validity::gather;
@@ -45,11 +46,10 @@ pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) 
     for (p, &zone) in prisms.nodes.chunks_exact(6).zip(&prisms.zone) {
         let top = [p[3], p[4], p[5]];
         if zone == layer_zone && top.iter().all(|&n| in_core[n as usize]) {
-            let x = |n: u32| mesh.points[n as usize];
             // The prism's volume over its top's area (exact for a right prism).
             let Some(corners) = gather(&mesh.points, p) else { continue };
             let volume = crate::quality::measures::volume(CellKind::Prism, &corners);
-            let area = (x(top[1]) - x(top[0])).cross(x(top[2]) - x(top[0])).length() / 2.0;
+            let area = triangle_area_vector(corners[3], corners[4], corners[5]).length() / 2.0;
             if area > 0.0 {
                 last_height.insert(key(top), volume / area);
             }
@@ -57,13 +57,13 @@ pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) 
     }
     let mut ratios = Vec::new();
     for t in core_tets() {
-        for skip in 0..4 {
-            let face: Vec<u32> = (0..4).filter(|&i| i != skip).map(|i| t[i]).collect();
-            if let Some(&h) = last_height.get(&key([face[0], face[1], face[2]])) {
+        for face in CellKind::Tetrahedron.faces() {
+            let [a, b, c] = [t[face[0]], t[face[1]], t[face[2]]];
+            if let Some(&h) = last_height.get(&key([a, b, c])) {
                 let x = |n: u32| mesh.points[n as usize];
-                let normal = (x(face[1]) - x(face[0])).cross(x(face[2]) - x(face[0])).normalize_or_zero();
-                let height = (x(t[skip]) - x(face[0])).dot(normal).abs();
-                ratios.push(height / h);
+                let apex = t.iter().copied().find(|n| ![a, b, c].contains(n)).map_or(x(a), x);
+                let normal = triangle_area_vector(x(a), x(b), x(c)).normalize_or_zero();
+                ratios.push((apex - x(a)).dot(normal).abs() / h);
             }
         }
     }
