@@ -8,13 +8,15 @@ use std::collections::HashMap;
 use std::path::Path;
 use std::process::Command;
 
-use blmesh::config::{Config, LayerCount, LayerSettings, Role};
+use blmesh::config::Role;
 use blmesh::io::cgns::{self, BcType, CgnsFile};
 use blmesh::io::{read_volume_mesh, write_volume_mesh, write_volume_mesh_with_roles, MeshFormat};
 use blmesh::mesh::{CellKind, VolumeMesh};
 use blmesh::pipeline::{run, MeshOptions};
 use blmesh::progress::Progress;
 use blmesh::quality::{self, measures, validity};
+
+mod common;
 
 const TRI_3: i32 = 5;
 const QUAD_4: i32 = 7;
@@ -23,14 +25,7 @@ const MIXED: i32 = 20;
 /// The layers of a box (prisms, fans of hexahedra, pyramids and tetrahedra at the corners), or
 /// the full mesh with the core and the farfield.
 fn box_mesh(core: bool) -> VolumeMesh {
-    let surface = blmesh::surface::shapes::cuboid(blmesh::geometry::DVec3::new(2.0, 1.0, 1.5), 3);
-    let layers = LayerSettings {
-        first_height: Some(0.01),
-        growth: Some(1.2),
-        count: Some(LayerCount::Fixed(5)),
-        thickness: None,
-    };
-    let config = Config { layers, ..Default::default() };
+    let (surface, config) = common::layered_box();
     let mesh = run(surface, &config, &MeshOptions { core }, Progress::hidden()).unwrap().mesh;
     for kind in CellKind::ALL {
         assert!(!mesh.block(kind).is_empty(), "the box mesh has {}s", kind.name());

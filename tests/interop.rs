@@ -10,6 +10,8 @@ use blmesh::io::{read_surface, read_volume_mesh, write_volume_mesh, MeshFormat};
 use blmesh::mesh::{CellKind, VolumeMesh};
 use blmesh::quality::{check, samples::hybrid_column, CheckReport};
 
+mod common;
+
 const SCRIPT: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/tests/python/interop.py");
 
 /// meshio's name of each cell kind.
@@ -79,16 +81,8 @@ fn hybrid_mesh_files_interoperate() {
 /// corners) as written by `blmesh mesh`.
 #[test]
 fn layer_mesh_files_interoperate() {
-    use blmesh::config::{Config, LayerCount, LayerSettings};
     use blmesh::pipeline::{run, MeshOptions};
-    let surface = blmesh::surface::shapes::cuboid(blmesh::geometry::DVec3::new(2.0, 1.0, 1.5), 3);
-    let layers = LayerSettings {
-        first_height: Some(0.01),
-        growth: Some(1.2),
-        count: Some(LayerCount::Fixed(5)),
-        thickness: None,
-    };
-    let config = Config { layers, ..Default::default() };
+    let (surface, config) = common::layered_box();
     let out =
         run(surface, &config, &MeshOptions { core: false }, blmesh::progress::Progress::hidden()).unwrap();
     for kind in CellKind::ALL {

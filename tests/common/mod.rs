@@ -1,0 +1,18 @@
+//! Set-ups shared by several integration tests.
+
+use blmesh::config::{Config, LayerCount, LayerSettings};
+use blmesh::geometry::DVec3;
+use blmesh::surface::{shapes, Surface};
+
+/// A 2 x 1 x 1.5 box (3 divisions per edge) and 5 layers of h0 = 0.01, r = 1.2: its layers have
+/// every cell kind (prisms, fans of hexahedra, pyramids and tetrahedra at the corners).
+pub fn layered_box() -> (Surface, Config) {
+    let surface = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 3);
+    let layers = LayerSettings {
+        first_height: Some(0.01),
+        growth: Some(1.2),
+        count: Some(LayerCount::Fixed(5)),
+        thickness: None,
+    };
+    (surface, Config { layers, ..Default::default() })
+}
