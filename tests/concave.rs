@@ -70,7 +70,6 @@ fn assert_full_coverage(name: &str, out: &MeshOutput) {
 }
 
 #[test]
-#[ignore = "issue 7: columns still stop at the saddle vertices where the concave ridge meets the convex edges (35 of 226 on 2026-11-22); run with --ignored to follow the progress"]
 fn l_block_layers_merge_on_the_bisector() {
     // 2 x 1 x 2 block without the (1, 0, 1) voxel: a 90-degree concave ridge along y.
     let surface = shapes::voxels([2, 1, 2], 1.0, 4, |i, _, k| !(i == 1 && k == 1));
@@ -83,7 +82,6 @@ fn l_block_layers_merge_on_the_bisector() {
 }
 
 #[test]
-#[ignore = "issue 7: columns still stop around the concave corner and the saddles (58 on 2026-11-22); run with --ignored to follow the progress"]
 fn notched_box_layers_merge_at_the_concave_corner() {
     // A cube without one octant: three concave ridges meeting at a concave corner.
     let surface = shapes::voxels([2, 2, 2], 0.5, 4, |i, j, k| !(i == 1 && j == 1 && k == 1));

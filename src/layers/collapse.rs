@@ -94,35 +94,40 @@ impl Merges {
         out
     }
 
-    /// Can roots `a` and `b` merge without making the front non-manifold? They must share an
-    /// edge between exactly two triangles, and have no common neighbour but those triangles'
-    /// third vertices (the link condition).
+    /// Can roots `a` and `b` merge without making the front non-manifold? Their edge must be
+    /// shared by exactly two faces (triangles, which vanish, or quads, which become triangles),
+    /// no other face may hold both, and their only common neighbours must be the third vertices
+    /// of those triangles (the link condition).
     pub fn can_collapse(&self, front: &Front, a: u32, b: u32) -> bool {
         if a == b || self.is_merged(a) || self.is_merged(b) {
             return false;
         }
+        let mut faces_on_edge = 0;
         let mut opposite = Vec::new();
         for f in self.faces_around(front, a) {
             let Some(p) = self.resolved_face(front, f) else { continue };
             let n = p.nodes();
             let Some(i) = n.iter().position(|&x| x == a) else { continue };
-            let (next, prev) = (n[(i + 1) % n.len()], n[(i + n.len() - 1) % n.len()]);
-            if next != b && prev != b {
+            if !n.contains(&b) {
                 continue;
             }
-            if n.len() != 3 {
-                return false; // a fan quad on the edge: the fan must not be twisted
+            let (next, prev) = (n[(i + 1) % n.len()], n[(i + n.len() - 1) % n.len()]);
+            if next != b && prev != b {
+                return false; // a and b are opposite corners of a quad
             }
-            opposite.extend(n.iter().copied().filter(|&x| x != a && x != b));
+            faces_on_edge += 1;
+            if n.len() == 3 {
+                opposite.extend(n.iter().copied().filter(|&x| x != a && x != b));
+            }
         }
-        if opposite.len() != 2 {
+        if faces_on_edge != 2 {
             return false;
         }
         opposite.sort_unstable();
         let (na, nb) = (self.neighbours(front, a), self.neighbours(front, b));
         let common: Vec<u32> = na.iter().copied().filter(|x| nb.binary_search(x).is_ok()).collect();
-        // The merged vertex and the two opposite ones (each losing an edge) keep a proper disc
-        // of at least three neighbours: no collapse of a tetrahedron into a flat pair.
+        // The merged vertex and the opposite ones (each losing an edge) keep a proper disc of at
+        // least three neighbours: no collapse of a tetrahedron into a flat pair.
         let merged_degree = na.len() + nb.len() - common.len() - 2;
         common == opposite
             && merged_degree >= 3

@@ -215,6 +215,31 @@ impl Front {
         })
     }
 
+    /// Are columns `a` and `b` the two ends of a front edge?
+    pub fn are_neighbours(&self, a: u32, b: u32) -> bool {
+        self.faces_of(a).any(|f| {
+            let cols = self.face_columns(f);
+            let n = cols.len();
+            (0..n).any(|i| cols[i] == a && (cols[(i + 1) % n] == b || cols[(i + n - 1) % n] == b))
+        })
+    }
+
+    /// How many distinct front neighbours of column `c` grow from wall vertex `v`.
+    pub fn neighbours_of_vertex(&self, c: u32, v: u32, columns: &Columns) -> usize {
+        let mut found: Vec<u32> = Vec::new();
+        for f in self.faces_of(c) {
+            let cols = self.face_columns(f);
+            let n = cols.len();
+            let Some(i) = cols.iter().position(|&x| x == c) else { continue };
+            for x in [cols[(i + 1) % n], cols[(i + n - 1) % n]] {
+                if columns.wall_vertex[x as usize] == v && !found.contains(&x) {
+                    found.push(x);
+                }
+            }
+        }
+        found.len()
+    }
+
     /// The faces touching any of `columns`, each once.
     pub fn faces_around_columns(&self, columns: &[u32]) -> Vec<usize> {
         let mut faces: Vec<usize> = columns.iter().flat_map(|&c| self.faces_of(c)).collect();

@@ -16,7 +16,7 @@ use super::collapse::Merges;
 use super::entropy;
 use super::front::{Columns, Front};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
-use super::slab::{slab_cell, Polygon, SlabCell};
+use super::slab::{slab_cell, Merging, Polygon, SlabCell};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::CellPoints;
@@ -69,12 +69,15 @@ impl Proposal<'_> {
             SlabCell::Empty => true,
             SlabCell::Flat => false,
             SlabCell::Standard { kind, nodes } => cell_validity(*kind, &self.gather(nodes)).is_valid(),
-            SlabCell::Split { faces } => {
-                let centre = self.centre(faces);
-                split_pieces(faces, u32::MAX).all(|(kind, nodes)| {
-                    let apex = nodes.len() - 1;
-                    let mut x = self.gather(&nodes[..apex]);
-                    x[apex] = centre;
+            SlabCell::Split { faces, apex } => {
+                let apex_point = match apex {
+                    Some(a) => self.position(*a),
+                    None => self.centre(faces),
+                };
+                split_pieces(faces, *apex, u32::MAX).all(|(kind, nodes)| {
+                    let last = nodes.len() - 1;
+                    let mut x = self.gather(&nodes[..last]);
+                    x[last] = apex_point;
                     cell_validity(kind, &x).is_valid()
                 })
             }
@@ -90,13 +93,19 @@ impl Proposal<'_> {
     }
 }
 
-/// The cells of a split polyhedron with apex `centre`: a tetrahedron per triangle face and a
-/// pyramid per quad face (the apex is the last node).
-fn split_pieces(faces: &[Polygon], centre: u32) -> impl Iterator<Item = (CellKind, Vec<u32>)> + '_ {
-    faces.iter().map(move |f| {
-        // The outward face reversed points into the cell, towards the centre.
+/// The cells of a split polyhedron: a tetrahedron per triangle face and a pyramid per quad face,
+/// with the apex as last node: node `apex` when given (faces through it give nothing), else the
+/// new centre node `centre`.
+fn split_pieces(
+    faces: &[Polygon],
+    apex: Option<u32>,
+    centre: u32,
+) -> impl Iterator<Item = (CellKind, Vec<u32>)> + '_ {
+    let top = apex.unwrap_or(centre);
+    faces.iter().filter(move |f| !f.nodes().contains(&top)).map(move |f| {
+        // The outward face reversed points into the cell, towards the apex.
         let mut nodes: Vec<u32> = f.nodes().iter().rev().copied().collect();
-        nodes.push(centre);
+        nodes.push(top);
         let kind = if f.is_quad() { CellKind::Pyramid } else { CellKind::Tetrahedron };
         (kind, nodes)
     })
@@ -136,22 +145,90 @@ impl SlabPlan {
     }
 }
 
-/// Bottom and top node ids of a front face under a slab plan.
+/// Bottom and top node ids of a front face under a slab plan, its size, and how its columns
+/// merged.
 fn face_nodes(
     front: &Front,
     f: usize,
     plan: &SlabPlan,
     columns: &Columns,
     committed: u32,
-) -> ([u32; 4], [u32; 4], usize) {
+) -> ([u32; 4], [u32; 4], usize, Merging) {
+    face_ends(front, f, columns, &plan.merges, |c| plan.top(c, columns, committed))
+}
+
+/// Bottom node, top node (`top(c)`) and merging of every column of face `f`, and its size.
+fn face_ends(
+    front: &Front,
+    f: usize,
+    columns: &Columns,
+    merges: &Merges,
+    top: impl Fn(u32) -> u32,
+) -> ([u32; 4], [u32; 4], usize, Merging) {
     let cols = front.face_columns(f);
+    let n = cols.len();
     let mut b = [0; 4];
     let mut t = [0; 4];
+    let mut merging = Merging::default();
     for (i, &c) in cols.iter().enumerate() {
         b[i] = columns.node[c as usize];
-        t[i] = plan.top(c, columns, committed);
+        t[i] = top(c);
+        if merges.is_merged(c) {
+            merging.merged |= 1 << i;
+        }
     }
-    (b, t, cols.len())
+    for i in 0..n {
+        let (a, c) = (cols[i], cols[(i + 1) % n]);
+        let from = if merges.is_merged(a) || merges.is_merged(c) {
+            Some(cut_from(front, merges, columns, a, c))
+        } else if columns.node[a as usize] == columns.wall_vertex[a as usize] {
+            closing_fan_cut(front, columns, a, c)
+        } else {
+            None
+        };
+        if let Some(from) = from {
+            merging.cut |= 1 << i;
+            if from == a {
+                merging.cut_from_first |= 1 << i;
+            }
+        }
+    }
+    (b, t, n, merging)
+}
+
+/// Where a convex ridge ends at a vertex with a single column `q` (a fin's leading edge meeting
+/// a body), the fan of the ridge's other vertex closes onto `q`: the lateral faces between `q`
+/// and the fan copies `p` still at the wall turn with the fan while `q` stays put, so they are
+/// twisted. Cut them from the fan copy's (shared) wall node: the first cell over each fan
+/// triangle is then the tetrahedron between two fan directions and `q`'s top. Returns `p`.
+fn closing_fan_cut(front: &Front, columns: &Columns, a: u32, b: u32) -> Option<u32> {
+    [(a, b), (b, a)].into_iter().find_map(|(p, q)| {
+        let v = columns.wall_vertex[p as usize];
+        let at_wall = columns.node[p as usize] == v;
+        (at_wall && columns.wall_vertex[q as usize] != v && front.neighbours_of_vertex(q, v, columns) >= 3)
+            .then_some(p)
+    })
+}
+
+/// Which end of front edge `(a, b)` the twisted lateral face over it is cut from (see
+/// [`Merging`]): the column that merged; when both did, the one that is a front neighbour of the
+/// other's survivor (the cell over the triangle they make with that survivor needs that cut),
+/// else the one at the smaller node. Symmetric in `a` and `b`.
+fn cut_from(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32) -> u32 {
+    match (merges.is_merged(a), merges.is_merged(b)) {
+        (true, false) => a,
+        (false, true) => b,
+        _ => {
+            let a_next = front.are_neighbours(a, merges.root(b));
+            let b_next = front.are_neighbours(b, merges.root(a));
+            match (a_next, b_next) {
+                (true, false) => a,
+                (false, true) => b,
+                _ if (columns.node[a as usize], a) < (columns.node[b as usize], b) => a,
+                _ => b,
+            }
+        }
+    }
 }
 
 /// March `layers` steps (or until every column has stopped), appending points and cells to
@@ -172,6 +249,7 @@ pub fn march(
     let mut guard = CrossingGuard::default();
     let wall_size = front.mean_edge_length_at_columns(&mesh.points, columns);
     for k in 1..=max_layers {
+        let _layer = tracing::debug_span!("layer", k).entered();
         for c in 0..columns.len() {
             if columns.alive[c] && distance(c, k).is_none() {
                 columns.alive[c] = false;
@@ -331,7 +409,7 @@ fn settle_slab(
         let crossing = guard.crossing_faces(&plan, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
         for f in crossing {
-            tracing::debug!(face = f, "the new front crosses itself: stopping the face's columns");
+            tracing::debug!(face = f, at = ?wall_points(front, f, columns), "the new front crosses itself: stopping the face's columns");
             for &c in front.face_columns(f) {
                 if plan.moving[plan.merges.root(c) as usize] {
                     changed.extend(plan.stop(c));
@@ -346,8 +424,11 @@ fn settle_slab(
     }
 }
 
-/// Check the cells over `to_check` and repair the invalid ones (a collapse where the cell is
-/// being crushed, else stopping its columns) until every cell is valid.
+/// Check the cells over `to_check` and repair the invalid ones until every cell is valid: a
+/// collapse where a cell is being crushed, else stopping its columns. Collapses come first: an
+/// invalid cell without a crushed edge of its own may be mended by a collapse next to it (its
+/// neighbour crosses the bisector in another cell), so its columns stop only after a round that
+/// collapsed nothing.
 fn repair_invalid_cells(
     plan: &mut SlabPlan,
     mesh: &VolumeMesh,
@@ -364,27 +445,44 @@ fn repair_invalid_cells(
                 .par_iter()
                 .copied()
                 .filter(|&f| {
-                    let (b, t, n) = face_nodes(front, f, plan, columns, committed);
-                    !proposal.cell_is_valid(&slab_cell(&b[..n], &t[..n]))
+                    let (b, t, n, merging) = face_nodes(front, f, plan, columns, committed);
+                    !proposal.cell_is_valid(&slab_cell(&b[..n], &t[..n], merging))
                 })
                 .collect()
         };
         let mut changed = Vec::new();
+        let mut uncollapsed = Vec::new();
         for &f in &invalid {
-            if let Some(merged) = entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points) {
-                changed.extend(merged);
-                continue;
+            match entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points) {
+                Some(merged) => changed.extend(merged),
+                None => uncollapsed.push(f),
             }
-            tracing::debug!(face = f, columns = ?front.face_columns(f), "invalid cell: stopping its columns");
+        }
+        if !changed.is_empty() {
+            // Only the cells around a merged column can change; the others wait for the round.
+            to_check = front.faces_around_columns(&changed);
+            to_check.extend(uncollapsed);
+            to_check.sort_unstable();
+            to_check.dedup();
+            continue;
+        }
+        for &f in &uncollapsed {
+            tracing::debug!(face = f, at = ?wall_points(front, f, columns), "invalid cell: stopping its columns");
             for &c in front.face_columns(f) {
                 if plan.moving[plan.merges.root(c) as usize] {
                     changed.extend(plan.stop(c));
                 }
             }
         }
-        // Only the cells around a column that stopped or merged can change.
+        // Only the cells around a column that stopped can change.
         to_check = front.faces_around_columns(&changed);
     }
+}
+
+/// Where face `f`'s columns start on the wall, with their scales (for the debug log).
+fn wall_points(front: &Front, f: usize, columns: &Columns) -> Vec<(u32, [f32; 3], f32)> {
+    let at = |c: u32| (c, columns.base[c as usize].as_vec3().to_array(), columns.scale[c as usize] as f32);
+    front.face_columns(f).iter().map(|&c| at(c)).collect()
 }
 
 /// Create the nodes of the moving columns, emit the slab's cells and apply the merges.
@@ -416,15 +514,8 @@ fn commit_slab(
     let cells: Vec<(bool, SlabCell)> = (0..front.len())
         .into_par_iter()
         .map(|f| {
-            let cols = front.face_columns(f);
-            let n = cols.len();
-            let mut b = [0; 4];
-            let mut t = [0; 4];
-            for (i, &c) in cols.iter().enumerate() {
-                b[i] = columns.node[c as usize];
-                t[i] = top[c as usize];
-            }
-            (b[..n] != t[..n], slab_cell(&b[..n], &t[..n]))
+            let (b, t, n, merging) = face_ends(front, f, columns, &plan.merges, |c| top[c as usize]);
+            (b[..n] != t[..n], slab_cell(&b[..n], &t[..n], merging))
         })
         .collect();
     for (f, (moved, cell)) in cells.into_iter().enumerate() {
@@ -478,12 +569,17 @@ fn emit_cell(mesh: &mut VolumeMesh, cell: SlabCell, stats: &mut MarchStats) {
     match cell {
         SlabCell::Empty | SlabCell::Flat => {}
         SlabCell::Standard { kind, nodes } => mesh.push_cell(kind, &nodes[..kind.node_count()], LAYER_ZONE),
-        SlabCell::Split { faces } => {
+        SlabCell::Split { faces, apex: Some(apex) } => {
+            for (kind, nodes) in split_pieces(&faces, Some(apex), u32::MAX) {
+                mesh.push_cell(kind, &nodes, LAYER_ZONE);
+            }
+        }
+        SlabCell::Split { faces, apex: None } => {
             let centre = mesh.points.len() as u32;
             let proposal = Proposal { points: &mesh.points, proposed: &[], committed: u32::MAX };
             let c = proposal.centre(&faces);
             mesh.points.push(c);
-            for (kind, nodes) in split_pieces(&faces, centre) {
+            for (kind, nodes) in split_pieces(&faces, None, centre) {
                 mesh.push_cell(kind, &nodes, LAYER_ZONE);
             }
             stats.steiner_points += 1;

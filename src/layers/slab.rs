@@ -9,9 +9,20 @@
 //! nodes, so the two cells sharing a face always agree on it: the slab is conforming by
 //! construction (DESIGN.md, "Staying conforming").
 //!
+//! A column that merged into another this slab (a collapse: its top is the survivor's top) makes
+//! the lateral quads beside it twisted: their top edge runs towards the survivor, away from the
+//! bottom edge. Such a quad is cut into two triangles along the diagonal from the merged
+//! column's bottom node (when both merged, the caller picks one from the edge's two columns, see
+//! [`Merging`]), so both cells agree. (The first lateral faces of a fan that closes onto a single
+//! column, at the end of a convex ridge, are twisted the same way and cut too.) The cell over a
+//! front triangle with a merged column
+//! is then a cone from that column's bottom node: no new point (the exact entropy picture: the
+//! merged characteristic ends there).
+//!
 //! The cell is then emitted as the standard shape its faces make (prism, pyramid, tetrahedron,
-//! hexahedron) or, for any other polyhedron, split from its centroid into one tetrahedron per
-//! triangle face and one pyramid per quad face (quads are never cut).
+//! hexahedron) or, for any other polyhedron, split from an apex (a merged column's bottom node,
+//! or else a new centre point) into one tetrahedron per triangle face and one pyramid per quad
+//! face not touching the apex (quads are never cut but for the twisted ones above).
 
 use crate::mesh::CellKind;
 
@@ -54,6 +65,12 @@ impl Polygon {
         p
     }
 
+    /// The same nodes in the same cyclic order (whatever the first one).
+    fn same_cycle(&self, other: &Polygon) -> bool {
+        let (a, b) = (self.nodes(), other.nodes());
+        a.len() == b.len() && (0..b.len()).any(|shift| (0..a.len()).all(|i| a[i] == b[(i + shift) % b.len()]))
+    }
+
     fn contains(&self, n: u32) -> bool {
         self.nodes().contains(&n)
     }
@@ -76,39 +93,91 @@ pub enum SlabCell {
     Flat,
     /// One standard cell in Gmsh node order (the first `kind.node_count()` of `nodes`).
     Standard { kind: CellKind, nodes: [u32; 8] },
-    /// A polyhedron to split from a new centre point: its outward faces.
-    Split { faces: Vec<Polygon> },
+    /// A polyhedron to split into pieces from an apex: its outward faces, and the apex node
+    /// (`None`: a new point at the centre of its nodes).
+    Split { faces: Vec<Polygon>, apex: Option<u32> },
+}
+
+/// Which columns of a slab cell merged into another column this slab (bit `i`: column `i`), and
+/// which twisted lateral faces are cut (bit `i` of `cut`: the quad over edge `(i, i + 1)`, from
+/// column `i`'s bottom node if bit `i` of `cut_from_first` is set, else from column `i + 1`'s).
+/// The caller decides the cuts from the edge's two columns only, so both cells sharing a lateral
+/// face cut it alike.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
+pub struct Merging {
+    pub merged: u8,
+    pub cut: u8,
+    pub cut_from_first: u8,
 }
 
 /// The outward faces of the cell over a front face with `bottom` and `top` node ids
 /// (the front face `bottom` is oriented with its right-hand normal pointing up, into the fluid).
-pub fn slab_faces(bottom: &[u32], top: &[u32]) -> Vec<Polygon> {
+/// Faces that come twice with opposite orientations (halves of cut quads lying on each other)
+/// are left out: they enclose nothing.
+pub fn slab_faces(bottom: &[u32], top: &[u32], merging: Merging) -> Vec<Polygon> {
     let n = bottom.len();
-    let mut faces = Vec::with_capacity(n + 2);
+    let mut faces = Vec::with_capacity(n + 4);
     let reversed_bottom: Vec<u32> = bottom.iter().rev().copied().collect();
     faces.extend(Polygon::dedup(&reversed_bottom));
     faces.extend(Polygon::dedup(top));
     for i in 0..n {
         let j = (i + 1) % n;
-        faces.extend(Polygon::dedup(&[bottom[i], bottom[j], top[j], top[i]]));
+        let quad = [bottom[i], bottom[j], top[j], top[i]];
+        let cut = (merging.cut & (1 << i) != 0).then_some(merging.cut_from_first & (1 << i) != 0);
+        push_lateral(&mut faces, quad, cut);
     }
+    remove_opposite_pairs(&mut faces);
     faces
 }
 
+/// The lateral face `(b_i, b_j, t_j, t_i)` over a front edge; a twisted quad (`cut` given) is cut
+/// along the diagonal from `b_i` (`Some(true)`) or `b_j` (`Some(false)`).
+fn push_lateral(faces: &mut Vec<Polygon>, quad: [u32; 4], cut: Option<bool>) {
+    let Some(face) = Polygon::dedup(&quad) else { return };
+    let (true, Some(from_i)) = (face.is_quad(), cut) else {
+        faces.push(face);
+        return;
+    };
+    let [bi, bj, tj, ti] = quad;
+    let halves = if from_i { [[bi, bj, tj], [bi, tj, ti]] } else { [[bi, bj, ti], [bj, tj, ti]] };
+    faces.extend(halves.iter().filter_map(|t| Polygon::dedup(t)));
+}
+
+/// Remove every pair of faces that are the same polygon with opposite orientations.
+fn remove_opposite_pairs(faces: &mut Vec<Polygon>) {
+    let mut i = 0;
+    while i < faces.len() {
+        let reversed = faces[i].reversed();
+        match (i + 1..faces.len()).find(|&j| faces[j].same_cycle(&reversed)) {
+            Some(j) => {
+                faces.remove(j);
+                faces.remove(i);
+            }
+            None => i += 1,
+        }
+    }
+}
+
 /// Decide the cell over a front face (see module docs).
-pub fn slab_cell(bottom: &[u32], top: &[u32]) -> SlabCell {
+pub fn slab_cell(bottom: &[u32], top: &[u32], merging: Merging) -> SlabCell {
     if bottom == top {
         return SlabCell::Empty;
     }
-    if let Some(cell) = intact_column_cell(bottom, top) {
-        return cell;
+    let merged = merging.merged;
+    if merging.cut == 0 {
+        if let Some(cell) = intact_column_cell(bottom, top) {
+            return cell;
+        }
     }
-    let faces = slab_faces(bottom, top);
+    let faces = slab_faces(bottom, top, merging);
     let mut distinct: Vec<u32> = faces.iter().flat_map(|f| f.nodes().iter().copied()).collect();
     distinct.sort_unstable();
     distinct.dedup();
     if faces.len() < 4 || distinct.len() < 4 {
         return SlabCell::Flat;
+    }
+    if merged != 0 {
+        return SlabCell::Split { apex: cone_apex(&faces, bottom, merged), faces };
     }
     let quads = faces.iter().filter(|f| f.is_quad()).count();
     let tris = faces.len() - quads;
@@ -121,8 +190,22 @@ pub fn slab_cell(bottom: &[u32], top: &[u32]) -> SlabCell {
     };
     match standard {
         Some((kind, nodes)) => standard_cell(kind, &nodes),
-        None => SlabCell::Split { faces },
+        None => SlabCell::Split { faces, apex: None },
     }
+}
+
+/// The apex of a cell with merged columns: the bottom node of a merged column through which
+/// every face is a triangle (a quad through the apex would have to be cut, and its other cell
+/// keeps it whole), and of those the one on the most faces: it leaves the fewest pieces, and the
+/// halves of a quad cut from it lie on it (ties: the smaller node). `None` if there is none.
+fn cone_apex(faces: &[Polygon], bottom: &[u32], merged: u8) -> Option<u32> {
+    (0..bottom.len())
+        .filter(|&i| merged & (1 << i) != 0)
+        .map(|i| bottom[i])
+        .filter(|&apex| faces.iter().all(|f| !(f.is_quad() && f.contains(apex))))
+        .map(|apex| (faces.iter().filter(|f| f.contains(apex)).count(), std::cmp::Reverse(apex)))
+        .max()
+        .map(|(_, std::cmp::Reverse(apex))| apex)
 }
 
 fn standard_cell(kind: CellKind, nodes: &[u32]) -> SlabCell {
@@ -200,7 +283,7 @@ mod tests {
     use super::*;
 
     fn standard(bottom: &[u32], top: &[u32]) -> (CellKind, Vec<u32>) {
-        match slab_cell(bottom, top) {
+        match slab_cell(bottom, top, Merging::default()) {
             SlabCell::Standard { kind, nodes } => (kind, nodes[..kind.node_count()].to_vec()),
             other => panic!("expected a standard cell, got {other:?}"),
         }
@@ -238,7 +321,7 @@ mod tests {
 
     #[test]
     fn all_stopped_gives_nothing() {
-        assert_eq!(slab_cell(&[0, 1, 2], &[0, 1, 2]), SlabCell::Empty);
+        assert_eq!(slab_cell(&[0, 1, 2], &[0, 1, 2], Merging::default()), SlabCell::Empty);
     }
 
     #[test]
@@ -270,11 +353,49 @@ mod tests {
     #[test]
     fn merged_top_with_two_quads_is_split() {
         // Columns 1 and 2 merge into node 9: faces are 2 quads and 3 triangles on 5 nodes.
-        match slab_cell(&[0, 1, 2], &[8, 9, 9]) {
-            SlabCell::Split { faces } => {
+        match slab_cell(&[0, 1, 2], &[8, 9, 9], Merging::default()) {
+            SlabCell::Split { faces, apex: None } => {
                 assert_eq!(faces.iter().filter(|f| f.is_quad()).count(), 2);
             }
             other => panic!("{other:?}"),
         }
+    }
+
+    /// Column 2 of face (0, 1, 2) merged into column 1 (tops 10, 11, 11); the lateral over
+    /// (2, 0) is cut from node 2.
+    fn merged_face() -> (Vec<Polygon>, SlabCell) {
+        let merging = Merging { merged: 0b100, cut: 0b110, cut_from_first: 0b100 };
+        (slab_faces(&[0, 1, 2], &[10, 11, 11], merging), slab_cell(&[0, 1, 2], &[10, 11, 11], merging))
+    }
+
+    #[test]
+    fn a_merged_column_is_the_apex_of_its_cell() {
+        let (_, cell) = merged_face();
+        let SlabCell::Split { faces, apex: Some(2) } = cell else { panic!("{cell:?}") };
+        let pieces: Vec<&Polygon> = faces.iter().filter(|f| !f.contains(2)).collect();
+        assert_eq!(pieces.len(), 1, "{faces:?}");
+        assert!(pieces[0].same_cycle(&Polygon::dedup(&[0, 1, 11, 10]).unwrap()), "{pieces:?}");
+    }
+
+    #[test]
+    fn both_cells_cut_a_twisted_quad_alike() {
+        let (faces_a, _) = merged_face();
+        // Face (0, 2, 4) shares the edge (2, 0); its lateral over (0, 2) is cut from node 2 too.
+        let merging = Merging { merged: 0b010, cut: 0b011, cut_from_first: 0b010 };
+        let faces_c = slab_faces(&[0, 2, 4], &[10, 11, 14], merging);
+        for half in [[0, 2, 10], [2, 11, 10]] {
+            let half = Polygon::dedup(&half).unwrap();
+            assert!(faces_c.iter().any(|f| f.same_cycle(&half)), "{faces_c:?}");
+            assert!(faces_a.iter().any(|f| f.same_cycle(&half.reversed())), "{faces_a:?}");
+        }
+    }
+
+    #[test]
+    fn opposite_faces_cancel() {
+        let mut faces: Vec<Polygon> =
+            [[1, 2, 3], [2, 1, 3], [3, 2, 1], [1, 4, 5]].iter().map(|t| Polygon::dedup(t).unwrap()).collect();
+        remove_opposite_pairs(&mut faces);
+        let left: Vec<&[u32]> = faces.iter().map(|f| f.nodes()).collect();
+        assert_eq!(left, vec![&[3, 2, 1][..], &[1, 4, 5][..]]);
     }
 }
