@@ -17,6 +17,7 @@ use super::entropy;
 use super::front::{Columns, Front};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Polygon, SlabCell};
+use super::split::{self, Adapt, Sizes, Splits, NONE};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::CellPoints;
@@ -37,6 +38,11 @@ pub struct MarchStats {
     pub collapses: usize,
     /// Times the crossing guard searched the whole front for candidate pairs.
     pub guard_rebuilds: usize,
+    /// Front edges split (a column born at each one's middle).
+    pub splits: usize,
+    /// Long front edges left unsplit for a layer because the split would have made an invalid
+    /// cell.
+    pub splits_given_up: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -154,53 +160,81 @@ fn face_nodes(
     (b, t, cols.len())
 }
 
+/// The cell over front face `f` under a slab plan, with its active splits; the new column of
+/// split `s` proposes the node `committed + columns.len() + s`.
+fn face_cell(
+    front: &Front,
+    f: usize,
+    plan: &SlabPlan,
+    splits: &Splits,
+    columns: &Columns,
+    committed: u32,
+) -> SlabCell {
+    let (b, t, n) = face_nodes(front, f, plan, columns, committed);
+    match splits.active_on_face(f, plan) {
+        None => slab_cell(&b[..n], &t[..n]),
+        Some(on_edge) => {
+            let first = committed + columns.len() as u32;
+            let mids = on_edge.map(|s| if s == NONE { NONE } else { first + s });
+            split::split_cell(&b[..n], &t[..n], &mids[..n])
+        }
+    }
+}
+
 /// March `layers` steps (or until every column has stopped), appending points and cells to
-/// `mesh`. `distance(c, k)` is how far column `c` should be from the wall after `k` layers, or
-/// `None` when its stack is complete. Columns with `stop_when_isotropic[c]` also end their stack
-/// before the first layer whose height would reach the front's edge length around them
-/// (`count = "auto"`); they are marked in `columns.isotropic_ratio`.
+/// `mesh`. `columns.distance(c, k)` is how far column `c` should be from the wall after `k`
+/// layers, or `None` when its stack is complete. Columns that stop when isotropic also end their
+/// stack before the first layer whose height would reach the front's edge length around them
+/// (`count = "auto"`); they are marked in `columns.isotropic_ratio`. Unless `sizes.adapt` is
+/// off, front edges
+/// that grow too long for `sizes` are split ([`super::split`]), which adds columns.
 pub fn march(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
     max_layers: u32,
-    distance: impl Fn(usize, u32) -> Option<f64> + Sync,
-    stop_when_isotropic: &[bool],
+    sizes: &mut Sizes,
     mut on_layer: impl FnMut(u32),
 ) -> MarchStats {
     let mut stats = MarchStats::default();
     let mut guard = CrossingGuard::default();
-    let wall_size = front.mean_edge_length_at_columns(&mesh.points, columns);
     for k in 1..=max_layers {
         for c in 0..columns.len() {
-            if columns.alive[c] && distance(c, k).is_none() {
+            if columns.alive[c] && columns.distance(c, k).is_none() {
                 columns.alive[c] = false;
             }
         }
-        if stop_when_isotropic.iter().any(|&s| s) {
-            stop_isotropic_columns(mesh, columns, front, k, &distance, stop_when_isotropic, &wall_size);
+        if (0..columns.len()).any(|c| columns.stops_when_isotropic(c)) {
+            stop_isotropic_columns(mesh, columns, front, k, &sizes.wall);
         }
         if !columns.alive.iter().any(|&a| a) {
             break;
         }
         let points = &mesh.points;
-        let proposed: Vec<DVec3> = (0..columns.len())
+        let mut proposed: Vec<DVec3> = (0..columns.len())
             .into_par_iter()
-            .map(|c| match (distance(c, k), distance(c, k - 1)) {
+            .map(|c| match (columns.distance(c, k), columns.distance(c, k - 1)) {
                 (Some(d), Some(d_before)) if columns.alive[c] => columns.slide[c].project(
                     points[columns.node[c] as usize] + columns.dir[c] * (columns.scale[c] * (d - d_before)),
                 ),
                 _ => DVec3::ZERO,
             })
             .collect();
-        let plan = settle_slab(mesh, columns, front, proposed, &mut guard, k, &distance);
+        let mut splits = match sizes.adapt {
+            Adapt::Off => Splits::default(),
+            Adapt::Wall | Adapt::Field(_) => split::propose(columns, front, &proposed, k, sizes),
+        };
+        proposed.extend_from_slice(&splits.top);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut splits, &mut guard, k);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses;
-        if plan.collapses > 0 || !plan.redirected.is_empty() {
+        let split_count = commit_slab(mesh, columns, front, &plan, &splits, sizes, k, &mut stats);
+        stats.splits += split_count;
+        stats.splits_given_up += splits.len() - split_count;
+        if plan.collapses > 0 || !plan.redirected.is_empty() || split_count > 0 {
             guard.invalidate();
         }
-        commit_slab(mesh, columns, front, &plan, &mut stats);
         stats.layers_marched = k;
         on_layer(k);
     }
@@ -219,21 +253,21 @@ fn stop_isotropic_columns(
     columns: &mut Columns,
     front: &Front,
     k: u32,
-    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
-    stop_when_isotropic: &[bool],
     wall_size: &[f64],
 ) {
     let edge = front.mean_edge_length_at_columns(&mesh.points, columns);
     let ended = ended_neighbour_layers(columns, front);
     let ends = |c: usize| {
-        let (Some(d), Some(d_before)) = (distance(c, k), distance(c, k - 1)) else { return false };
+        let (Some(d), Some(d_before)) = (columns.distance(c, k), columns.distance(c, k - 1)) else {
+            return false;
+        };
         // A neighbour's stack ended more than one layer lower: end here too, so that the stacks
         // step down one layer at a time (no cliff in the final front).
         let cliff = ended[c] < columns.layers[c];
         cliff || d - d_before >= edge[c].min(wall_size[c])
     };
     let candidates: Vec<bool> =
-        (0..columns.len()).map(|c| columns.alive[c] && stop_when_isotropic[c]).collect();
+        (0..columns.len()).map(|c| columns.alive[c] && columns.stops_when_isotropic(c)).collect();
     // The columns of one wall vertex (a fan) end together: a fan strip cell with one side
     // stopped and the other moving would be flat.
     let mut vertex_ends = vec![false; columns.wall_vertex_count()];
@@ -244,8 +278,10 @@ fn stop_isotropic_columns(
         if candidates[c] && vertex_ends[columns.wall_vertex[c] as usize] {
             columns.alive[c] = false;
             // The last layer built, against the tangential size it ended at.
-            let (d_before, d_last) =
-                (distance(c, k - 1).unwrap_or(0.0), k.checked_sub(2).and_then(|j| distance(c, j)));
+            let (d_before, d_last) = (
+                columns.distance(c, k - 1).unwrap_or(0.0),
+                k.checked_sub(2).and_then(|j| columns.distance(c, j)),
+            );
             columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / edge[c];
         }
     }
@@ -268,13 +304,7 @@ fn ended_neighbour_layers(columns: &Columns, front: &Front) -> Vec<u32> {
 /// Where every column will be at the end of the guard's horizon: after layer `k` if the slab
 /// has merged columns (they move to other columns' positions), else after the next
 /// [`LOOKAHEAD_LAYERS`] layers if it keeps moving (or its last layer, if that comes first).
-fn reach(
-    plan: &SlabPlan,
-    mesh: &VolumeMesh,
-    columns: &Columns,
-    k: u32,
-    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
-) -> Reach {
+fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach {
     let committed = mesh.points.len() as u32;
     let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
     if plan.collapses > 0 {
@@ -287,8 +317,8 @@ fn reach(
         .into_par_iter()
         .map(|c| {
             let node = mesh.points[columns.node[c] as usize];
-            let now = distance(c, k - 1);
-            let ahead = (k..=last).rev().find_map(|j| distance(c, j));
+            let now = columns.distance(c, k - 1);
+            let ahead = (k..=last).rev().find_map(|j| columns.distance(c, j));
             match (now, ahead) {
                 (Some(d0), Some(d1)) if plan.moving[c] => {
                     node + columns.dir[c] * (columns.scale[c] * (d1 - d0))
@@ -307,9 +337,9 @@ fn settle_slab(
     columns: &Columns,
     front: &Front,
     proposed: Vec<DVec3>,
+    splits: &mut Splits,
     guard: &mut CrossingGuard,
     k: u32,
-    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
 ) -> SlabPlan {
     let mut plan = SlabPlan {
         moving: columns.alive.clone(),
@@ -324,9 +354,9 @@ fn settle_slab(
         .filter(|&f| front.face_columns(f).iter().any(|&c| plan.moving[c as usize]))
         .collect();
     loop {
-        repair_invalid_cells(&mut plan, mesh, columns, front, to_check);
+        repair_invalid_cells(&mut plan, splits, mesh, columns, front, to_check);
         if guard.is_stale(k, &plan) {
-            guard.rebuild(&plan, mesh, columns, front, reach(&plan, mesh, columns, k, distance));
+            guard.rebuild(&plan, mesh, columns, front, reach(&plan, mesh, columns, k));
         }
         let crossing = guard.crossing_faces(&plan, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
@@ -346,10 +376,12 @@ fn settle_slab(
     }
 }
 
-/// Check the cells over `to_check` and repair the invalid ones (a collapse where the cell is
-/// being crushed, else stopping its columns) until every cell is valid.
+/// Check the cells over `to_check` and repair the invalid ones (giving up their splits, else a
+/// collapse where the cell is being crushed, else stopping its columns) until every cell is
+/// valid.
 fn repair_invalid_cells(
     plan: &mut SlabPlan,
+    splits: &mut Splits,
     mesh: &VolumeMesh,
     columns: &Columns,
     front: &Front,
@@ -359,18 +391,21 @@ fn repair_invalid_cells(
     while !to_check.is_empty() {
         let invalid: Vec<usize> = {
             let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-            let plan = &*plan;
+            let (plan, splits) = (&*plan, &*splits);
             to_check
                 .par_iter()
                 .copied()
-                .filter(|&f| {
-                    let (b, t, n) = face_nodes(front, f, plan, columns, committed);
-                    !proposal.cell_is_valid(&slab_cell(&b[..n], &t[..n]))
-                })
+                .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, splits, columns, committed)))
                 .collect()
         };
         let mut changed = Vec::new();
+        let mut changed_faces = Vec::new();
         for &f in &invalid {
+            let given_up = splits.give_up(f, plan);
+            if !given_up.is_empty() {
+                changed_faces.extend(given_up);
+                continue;
+            }
             if let Some(merged) = entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points) {
                 changed.extend(merged);
                 continue;
@@ -382,25 +417,40 @@ fn repair_invalid_cells(
                 }
             }
         }
-        // Only the cells around a column that stopped or merged can change.
+        // Only the cells around a column that stopped or merged, or on a split given up, change.
         to_check = front.faces_around_columns(&changed);
+        if !changed_faces.is_empty() {
+            to_check.extend(changed_faces);
+            to_check.sort_unstable();
+            to_check.dedup();
+        }
     }
 }
 
-/// Create the nodes of the moving columns, emit the slab's cells and apply the merges.
+/// Create the nodes of the moving columns and of the splits, emit the slab's cells, add the
+/// split columns and apply the merges; returns the number of splits made.
+#[allow(clippy::too_many_arguments)]
 fn commit_slab(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
     plan: &SlabPlan,
+    splits: &Splits,
+    sizes: &mut Sizes,
+    k: u32,
     stats: &mut MarchStats,
-) {
+) -> usize {
     let mut new_node = vec![u32::MAX; columns.len()];
     for c in 0..columns.len() {
         if plan.moving[c] && !plan.merges.is_merged(c as u32) {
             new_node[c] = mesh.points.len() as u32;
             mesh.points.push(plan.proposed[c]);
         }
+    }
+    let mut mid_node = vec![NONE; splits.len()];
+    for s in splits.active(plan) {
+        mid_node[s] = mesh.points.len() as u32;
+        mesh.points.push(splits.top[s]);
     }
     let top: Vec<u32> = (0..columns.len() as u32)
         .map(|c| {
@@ -424,7 +474,14 @@ fn commit_slab(
                 b[i] = columns.node[c as usize];
                 t[i] = top[c as usize];
             }
-            (b[..n] != t[..n], slab_cell(&b[..n], &t[..n]))
+            let cell = match splits.active_on_face(f, plan) {
+                None => slab_cell(&b[..n], &t[..n]),
+                Some(on_edge) => {
+                    let mids = on_edge.map(|s| if s == NONE { NONE } else { mid_node[s as usize] });
+                    split::split_cell(&b[..n], &t[..n], &mids[..n])
+                }
+            };
+            (b[..n] != t[..n], cell)
         })
         .collect();
     for (f, (moved, cell)) in cells.into_iter().enumerate() {
@@ -456,9 +513,16 @@ fn commit_slab(
         columns.dir[c as usize] = dir;
         columns.scale[c as usize] = scale;
     }
+    let old_count = columns.len() as u32;
+    let made = split::commit(splits, plan, &mid_node, k, columns, front, sizes);
     if plan.collapses > 0 {
-        front.apply_merges(plan.merges.roots());
+        let mut carrier = plan.merges.roots().to_vec();
+        carrier.extend(old_count..columns.len() as u32);
+        front.apply_merges(&carrier);
+    } else if made > 0 {
+        front.index_columns(columns.len());
     }
+    made
 }
 
 /// Remember column `c`'s new step and how it compares with the one before.

@@ -12,6 +12,7 @@ pub mod march;
 pub mod slab;
 pub mod sliding;
 pub mod smoothness;
+pub mod split;
 
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
@@ -20,6 +21,7 @@ use crate::normals::WallNormals;
 use crate::surface::Surface;
 
 pub use march::MarchStats;
+pub use split::Adapt;
 
 /// Name of the boundary patch made of the top faces of the layers.
 pub const TOP_PATCH: &str = "bl_top";
@@ -42,11 +44,13 @@ pub struct Layers {
 }
 
 /// Extrude the wall. `patch_spec[p]` is the layer stack of patch `p`, `None` for patches
-/// without layers (their vertices do not move).
+/// without layers (their vertices do not move). `adapt` says whether and to which sizes the
+/// front's edges are split while it marches.
 pub fn build_layers(
     surface: &Surface,
     normals: &WallNormals,
     patch_spec: &[Option<LayerSpec>],
+    adapt: Adapt,
     mut on_layer: impl FnMut(u32, u32),
 ) -> Layers {
     let (mut columns, mut front) = front::initial_front(surface, normals);
@@ -55,38 +59,37 @@ pub fn build_layers(
     front.retain_patches(layered, columns.len());
     let mut column_spec = column_specs(normals, &front, patch_spec);
     grade_first_heights(surface, &columns, &mut column_spec);
-    for (c, spec) in column_spec.iter().enumerate() {
-        columns.alive[c] = spec.is_some() && columns.slide[c] != Slide::Fixed;
+    columns.spec = column_spec;
+    for c in 0..columns.len() {
+        columns.alive[c] = columns.spec[c].is_some() && columns.slide[c] != Slide::Fixed;
     }
-    let target = |c: usize| column_spec[c].map(|s| s.max_count());
-    let auto: Vec<bool> = column_spec.iter().map(|s| s.is_some_and(|s| s.fixed_count().is_none())).collect();
-    let max_layers = (0..columns.len()).filter_map(target).max().unwrap_or(0);
+    let max_layers = (0..columns.len()).filter_map(|c| columns.target(c)).max().unwrap_or(0);
     let mut mesh = VolumeMesh {
         points: surface.points.clone(),
         zone_names: vec![LAYER_ZONE_NAME.to_owned()],
         ..Default::default()
     };
-    let distance =
-        |c: usize, k: u32| column_spec[c].filter(|_| k <= target(c).unwrap_or(0)).map(|s| s.distance(k));
-    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, distance, &auto, |k| {
+    let mut sizes = split::Sizes::new(adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
+    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, |k| {
         on_layer(k, max_layers)
     });
+    let front_edges = sizes.front_edge_lengths(&mesh.points, &columns, &front);
     add_boundary(&mut mesh, surface, &front, &columns);
     let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
     let reached: Vec<Option<f64>> = (0..columns.len())
         .map(|c| {
             let carrier = columns.carrier(c);
             let layers = columns.layers[carrier];
-            (layers > 0).then(|| distance(carrier, layers)).flatten()
+            (layers > 0).then(|| columns.distance(carrier, layers)).flatten()
         })
         .collect();
-    let smoothness = smoothness::measure(surface, &columns, &reached, growth);
+    let smoothness = smoothness::measure(surface, &columns, &reached, growth, front_edges);
     let mut vertex_layers: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut vertex_target: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut stopped_vertices = Vec::new();
     for c in 0..columns.len() {
         let v = columns.wall_vertex[c] as usize;
-        if let Some(t) = target(c) {
+        if let Some(t) = columns.target(c) {
             // A column that merged is carried on by the bisector column it merged into.
             let carrier = columns.carrier(c);
             let reached = columns.layers[carrier];

@@ -103,7 +103,12 @@ pub fn slab_cell(bottom: &[u32], top: &[u32]) -> SlabCell {
     if let Some(cell) = intact_column_cell(bottom, top) {
         return cell;
     }
-    let faces = slab_faces(bottom, top);
+    cell_from_faces(slab_faces(bottom, top))
+}
+
+/// The cell enclosed by `faces` (outward polygons): the standard shape they make, a polyhedron
+/// to split from its centre, or flat when they enclose no volume.
+pub fn cell_from_faces(faces: Vec<Polygon>) -> SlabCell {
     let mut distinct: Vec<u32> = faces.iter().flat_map(|f| f.nodes().iter().copied()).collect();
     distinct.sort_unstable();
     distinct.dedup();
