@@ -31,6 +31,8 @@ pub struct Columns {
     /// For a column that ended its stack because its next cell would have been isotropic: its
     /// last layer's height over the front's tangential size then; NaN for the others.
     pub isotropic_ratio: Vec<f64>,
+    /// For those columns: the front's tangential size they ended at (NaN for the others).
+    pub isotropic_size: Vec<f64>,
     /// Length of the column's last step (its last layer's height along it).
     pub last_step: Vec<f64>,
     /// The ratio of a step to the one before that is farthest from 1 (0 before two steps).
@@ -86,6 +88,7 @@ impl Columns {
         self.merged_into.push(NOT_MERGED);
         self.slide.push(start.slide);
         self.isotropic_ratio.push(f64::NAN);
+        self.isotropic_size.push(f64::NAN);
         self.last_step.push(start.last_step);
         self.max_step_ratio.push(0.0);
         self.spec.push(start.spec);
@@ -291,6 +294,18 @@ impl Front {
             let cols = self.face_columns(f);
             (0..cols.len()).map(move |i| (cols[i] as usize, cols[(i + 1) % cols.len()] as usize))
         })
+    }
+
+    /// Append the columns next to `c` along the front's edges to `out` (twice for an edge
+    /// inside the front).
+    pub fn neighbours(&self, c: usize, out: &mut Vec<usize>) {
+        for f in self.faces_of(c as u32) {
+            let cols = self.face_columns(f);
+            let n = cols.len();
+            if let Some(i) = cols.iter().position(|&x| x as usize == c) {
+                out.extend([cols[(i + 1) % n] as usize, cols[(i + n - 1) % n] as usize]);
+            }
+        }
     }
 
     /// The faces touching any of `columns`, each once.

@@ -205,7 +205,8 @@ pub fn march(
             }
         }
         if (0..columns.len()).any(|c| columns.stops_when_isotropic(c)) {
-            stop_isotropic_columns(mesh, columns, front, k, &sizes.wall);
+            let wall_size = matches!(sizes.adapt, Adapt::Off).then_some(sizes.wall.as_slice());
+            stop_isotropic_columns(mesh, columns, front, k, wall_size);
         }
         if !columns.alive.iter().any(|&a| a) {
             break;
@@ -243,19 +244,21 @@ pub fn march(
 }
 
 /// End the stacks of the columns whose next layer (the `k`-th) would be at least as high as the
-/// front's tangential size around them ([`Front::mean_edge_length_at_columns`]): its cells would
-/// be isotropic, which the core's tetrahedra do better. Where the front widens faster than the
-/// layers grow (convex walls coarser than the growth rate can follow, until tangential
-/// refinement splits their edges), the wall's own tangential size `wall_size` ends the stack
-/// instead.
+/// front's tangential size around them: its cells would be isotropic, which the core's
+/// tetrahedra do better. That size is the mean edge length at the column's wall vertex
+/// ([`Front::mean_edge_length_at_columns`]) graded over the front so that neighbours' sizes
+/// differ by at most the growth ratio ([`front_sizes`]): then neighbouring stacks end at most one
+/// layer apart (the cliff rule below seldom has to end a stack early). Where the front widens
+/// faster than the layers grow and is not split (`wall_size` given: convex walls coarser than
+/// the growth rate can follow), the wall's own tangential size ends the stack instead.
 fn stop_isotropic_columns(
     mesh: &VolumeMesh,
     columns: &mut Columns,
     front: &Front,
     k: u32,
-    wall_size: &[f64],
+    wall_size: Option<&[f64]>,
 ) {
-    let edge = front.mean_edge_length_at_columns(&mesh.points, columns);
+    let size = front_sizes(&mesh.points, columns, front);
     let ended = ended_neighbour_layers(columns, front);
     let ends = |c: usize| {
         let (Some(d), Some(d_before)) = (columns.distance(c, k), columns.distance(c, k - 1)) else {
@@ -264,7 +267,7 @@ fn stop_isotropic_columns(
         // A neighbour's stack ended more than one layer lower: end here too, so that the stacks
         // step down one layer at a time (no cliff in the final front).
         let cliff = ended[c] < columns.layers[c];
-        cliff || d - d_before >= edge[c].min(wall_size[c])
+        cliff || d - d_before >= wall_size.map_or(size[c], |w| size[c].min(w[c]))
     };
     let candidates: Vec<bool> =
         (0..columns.len()).map(|c| columns.alive[c] && columns.stops_when_isotropic(c)).collect();
@@ -282,9 +285,53 @@ fn stop_isotropic_columns(
                 columns.distance(c, k - 1).unwrap_or(0.0),
                 k.checked_sub(2).and_then(|j| columns.distance(c, j)),
             );
-            columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / edge[c];
+            columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / size[c];
+            // What its neighbours are graded from: no more than the layer it did not build (a
+            // column may end with its wall vertex's others before its own size says so).
+            let refused = columns.distance(c, k).map_or(size[c], |d| d - d_before);
+            columns.isotropic_size[c] = size[c].min(refused);
         }
     }
+}
+
+/// The front's tangential size at every column for the isotropic stop: the mean edge length at
+/// its wall vertex (for a stack already ended: the size it ended at), lowered where a
+/// neighbour's size times a little less than the growth ratio is smaller. The columns of a
+/// wall vertex, which end together, share the smallest of their sizes.
+fn front_sizes(points: &[DVec3], columns: &Columns, front: &Front) -> Vec<f64> {
+    let mut size = front.mean_edge_length_at_columns(points, columns);
+    for (s, &ended) in size.iter_mut().zip(&columns.isotropic_size) {
+        if !ended.is_nan() {
+            *s = ended;
+        }
+    }
+    let mut by_vertex: Vec<u32> = (0..columns.len() as u32).collect();
+    by_vertex.sort_unstable_by_key(|&c| columns.wall_vertex[c as usize]);
+    let mut first = vec![0u32; columns.wall_vertex_count() + 1];
+    for &c in &by_vertex {
+        first[columns.wall_vertex[c as usize] as usize + 1] += 1;
+    }
+    for v in 0..first.len() - 1 {
+        first[v + 1] += first[v];
+    }
+    let siblings = |c: usize| {
+        let v = columns.wall_vertex[c] as usize;
+        by_vertex[first[v] as usize..first[v + 1] as usize].iter().map(|&s| s as usize)
+    };
+    let growth = |c: usize| columns.spec[c].map_or(f64::INFINITY, |s| s.growth);
+    let ratio = |a: usize, b: usize| {
+        if columns.wall_vertex[a] == columns.wall_vertex[b] {
+            1.0
+        } else {
+            growth(a).min(growth(b)).powf(super::GRADING_SHARE)
+        }
+    };
+    let neighbours = |c: usize, out: &mut Vec<usize>| {
+        front.neighbours(c, out);
+        out.extend(siblings(c));
+    };
+    super::graded_minimum(&mut size, neighbours, ratio);
+    size
 }
 
 /// For every column, the fewest layers of a neighbour (across a front edge) whose stack ended at

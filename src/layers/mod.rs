@@ -130,7 +130,7 @@ fn column_specs(
 }
 
 /// The share of the growth ratio (as an exponent) that neighbouring first heights may differ by.
-const GRADING_SHARE: f64 = 0.9;
+pub(crate) const GRADING_SHARE: f64 = 0.9;
 
 /// Where patches with different first heights meet, lower the larger ones near the border so
 /// that neighbouring wall vertices' first heights (and with equal counts and growth, their
@@ -163,29 +163,46 @@ fn grade_first_heights(surface: &Surface, columns: &front::Columns, column_spec:
             neighbours[a as usize].push(b);
         }
     }
-    // Dijkstra on the multiplicative metric: settle the smallest height first.
-    let mut heap: std::collections::BinaryHeap<std::cmp::Reverse<(u64, u32)>> = (0..n as u32)
-        .filter(|&v| height[v as usize].is_finite())
-        .map(|v| std::cmp::Reverse((height[v as usize].to_bits(), v)))
-        .collect();
-    while let Some(std::cmp::Reverse((bits, v))) = heap.pop() {
-        let h = f64::from_bits(bits);
-        if h > height[v as usize] {
-            continue;
-        }
-        for &w in &neighbours[v as usize] {
-            let w = w as usize;
-            // A little under r: the thickness of curved fronts varies a little more than h0.
-            let limit = h * growth[w].min(growth[v as usize]).powf(GRADING_SHARE);
-            if height[w].is_finite() && limit < height[w] {
-                height[w] = limit;
-                heap.push(std::cmp::Reverse((limit.to_bits(), w as u32)));
-            }
-        }
-    }
+    // A little under r: the thickness of curved fronts varies a little more than h0.
+    graded_minimum(
+        &mut height,
+        |v, out| out.extend(neighbours[v].iter().map(|&w| w as usize)),
+        |v, w| growth[w].min(growth[v]).powf(GRADING_SHARE),
+    );
     for (c, spec) in column_spec.iter_mut().enumerate() {
         if let Some(s) = spec {
             s.first_height = s.first_height.min(height[columns.wall_vertex[c] as usize]);
+        }
+    }
+}
+
+/// Lower `values` so that no value exceeds a neighbour's times `ratio(neighbour, it)`: the
+/// largest such field under the given one (a graded minimum, by Dijkstra's order: smallest
+/// first). Values that are not finite stay as they are and constrain nothing.
+/// `neighbours(v, out)` appends the neighbours of `v` to `out`.
+pub(crate) fn graded_minimum(
+    values: &mut [f64],
+    neighbours: impl Fn(usize, &mut Vec<usize>),
+    ratio: impl Fn(usize, usize) -> f64,
+) {
+    use std::cmp::Reverse;
+    let mut heap: std::collections::BinaryHeap<Reverse<(u64, usize)>> = (0..values.len())
+        .filter(|&v| values[v].is_finite() && values[v] >= 0.0)
+        .map(|v| Reverse((values[v].to_bits(), v)))
+        .collect();
+    let mut around = Vec::new();
+    while let Some(Reverse((bits, v))) = heap.pop() {
+        if f64::from_bits(bits) > values[v] {
+            continue;
+        }
+        around.clear();
+        neighbours(v, &mut around);
+        for &w in &around {
+            let limit = values[v] * ratio(v, w);
+            if values[w].is_finite() && limit < values[w] {
+                values[w] = limit;
+                heap.push(Reverse((limit.to_bits(), w)));
+            }
         }
     }
 }
