@@ -112,6 +112,9 @@ struct MeshArgs {
     /// Write only the layers (no core tetrahedra).
     #[arg(long)]
     no_core: bool,
+    /// Do not split the layers' front edges that grow too long (tangential adaptivity).
+    #[arg(long)]
+    no_adapt: bool,
     /// Write MSH as ASCII instead of binary.
     #[arg(long)]
     ascii: bool,
@@ -295,6 +298,9 @@ fn mesh_config(args: &MeshArgs) -> Result<Config> {
     }
     config.feature_angle = args.feature_angle.or(config.feature_angle);
     config.fan_angle = args.fan_angle.or(config.fan_angle);
+    if args.no_adapt {
+        config.sizing.adapt = Some(false);
+    }
     config.validate()?;
     Ok(config)
 }

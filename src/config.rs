@@ -17,6 +17,15 @@
 //! match = "face9"              # patch name or regex (whole name)
 //! role = "symmetry"            # wall | symmetry | farfield | inlet | outlet | none
 //! first_height = 2.0e-5        # per-patch layer overrides (wall patches), or yplus = ...
+//! [sizing]                     # tangential sizes the layers' front is split to
+//! adapt = true                 # split front edges that grow too long (default; --no-adapt)
+//! max_size = 0.5               # with max_size or regions: a sizing field (see `crate::sizing`)
+//! gradation = 1.2
+//! [[sizing.regions]]
+//! shape = "sphere"             # or "box" with min = [..], max = [..]
+//! center = [0.0, 0.0, 0.0]
+//! radius = 1.1
+//! size = 0.02
 //! [flow_conditions]            # for yplus: Re on a reference length (heights in its units)
 //! reynolds = 14.6e6
 //! length = 646.07
@@ -171,6 +180,41 @@ pub struct Config {
     pub layers: LayerSettings,
     #[serde(default, rename = "patch")]
     pub patches: Vec<PatchRule>,
+    #[serde(default)]
+    pub sizing: SizingSettings,
+}
+
+/// The sizes the layers' front is kept to while it marches (tangential adaptivity).
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct SizingSettings {
+    /// Split front edges that grow too long (default true).
+    pub adapt: Option<bool>,
+    /// Largest size anywhere (default: the body size).
+    pub max_size: Option<f64>,
+    /// Sizes grow by at most `gradation - 1` per unit length away from where they are set.
+    pub gradation: Option<f64>,
+    /// Where the user wants given isotropic sizes.
+    #[serde(default)]
+    pub regions: Vec<crate::sizing::Region>,
+}
+
+impl SizingSettings {
+    pub fn adapt(&self) -> bool {
+        self.adapt.unwrap_or(true)
+    }
+
+    /// The sizing field's spec when the user asked for one (a maximum size or regions), with the
+    /// layer law of `layers`; `None` keeps the front to the wall's own sizes.
+    pub fn field_spec(&self, layers: &LayerSpec, body_size: f64) -> Option<crate::sizing::SizingSpec> {
+        (self.max_size.is_some() || !self.regions.is_empty()).then(|| crate::sizing::SizingSpec {
+            first_height: layers.first_height,
+            growth: layers.growth,
+            max_size: self.max_size.unwrap_or(body_size),
+            gradation: self.gradation.unwrap_or(crate::sizing::DEFAULT_GRADATION),
+            regions: self.regions.clone(),
+        })
+    }
 }
 
 #[derive(Debug, thiserror::Error)]

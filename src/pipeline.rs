@@ -6,12 +6,13 @@ use serde::Serialize;
 use crate::config::{Config, ConfigError, Flow, LayerSpec, Role};
 use crate::fill::{fill_core_on_symmetry_plane, CoreOptions, CoreStats, FillError};
 use crate::layers::sliding::SlidingError;
-use crate::layers::{self, MarchStats};
+use crate::layers::{self, Adapt, MarchStats};
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::normals::constraint::{self, Plane};
 use crate::normals::{self, NormalStats};
 use crate::progress::{Progress, Timings};
 use crate::quality::{self, CheckReport};
+use crate::sizing::SizingField;
 use crate::surface::features::{FeatureCounts, Features, VertexKind};
 use crate::surface::topology::Topology;
 use crate::surface::validate::{validate, ValidationError, ValidationOptions};
@@ -37,6 +38,8 @@ pub enum MeshError {
     Fill(#[from] FillError),
     #[error("the layers cannot be closed against a patch without layers: {0}")]
     Sliding(#[from] SlidingError),
+    #[error(transparent)]
+    Sizing(#[from] crate::sizing::SpecError),
     #[error("the mesh failed its own check (a bug in blmesh; please report it):\n{0}")]
     InvalidResult(Box<CheckReport>),
 }
@@ -154,9 +157,18 @@ pub fn run(
         n.slides = constraint::constrain_columns(&surface, &mut n, &layered_patch, &planes);
         n
     });
+    let sizing = match config.sizing.field_spec(&LayerSpec::resolve(&config.layers, body_size)?, body_size) {
+        Some(spec) => Some(timings.time("sizing", || SizingField::new(&surface, &spec))?),
+        None => None,
+    };
+    let adapt = match (&sizing, config.sizing.adapt()) {
+        (_, false) => Adapt::Off,
+        (Some(field), true) => Adapt::Field(field),
+        (None, true) => Adapt::Wall,
+    };
     let bar = progress.bar(0, "layers");
     let (mut layered, core_wall) = timings.time("layers", || {
-        let mut layered = layers::build_layers(&surface, &wall_normals, &patch_spec, |k, n| {
+        let mut layered = layers::build_layers(&surface, &wall_normals, &patch_spec, adapt, |k, n| {
             bar.set_length(n as u64);
             bar.set_position(k as u64);
         });

@@ -1,6 +1,7 @@
 //! The marching front: columns (one per extrusion direction of a wall vertex) and the front
 //! faces over them (the wall triangles, plus the fan strips and corner patches of convex ridges).
 
+use crate::config::LayerSpec;
 use crate::geometry::DVec3;
 use crate::normals::constraint::Slide;
 use crate::normals::WallNormals;
@@ -30,10 +31,31 @@ pub struct Columns {
     /// For a column that ended its stack because its next cell would have been isotropic: its
     /// last layer's height over the front's tangential size then; NaN for the others.
     pub isotropic_ratio: Vec<f64>,
+    /// For those columns: the front's tangential size they ended at (NaN for the others).
+    pub isotropic_size: Vec<f64>,
     /// Length of the column's last step (its last layer's height along it).
     pub last_step: Vec<f64>,
     /// The ratio of a step to the one before that is farthest from 1 (0 before two steps).
     pub max_step_ratio: Vec<f64>,
+    /// The column's layer stack (`None`: no layers).
+    pub spec: Vec<Option<LayerSpec>>,
+}
+
+/// Where a new column starts and how it moves (see [`Columns::push`]).
+#[derive(Clone, Copy, Debug)]
+pub struct ColumnStart {
+    pub base: DVec3,
+    pub dir: DVec3,
+    pub scale: f64,
+    /// Its first node.
+    pub node: u32,
+    /// Layers below that node (0 on the wall; a column born by a split starts higher).
+    pub layers: u32,
+    pub wall_vertex: u32,
+    pub slide: Slide,
+    pub spec: Option<LayerSpec>,
+    /// Height of the layer under `node` along the column (0 on the wall).
+    pub last_step: f64,
 }
 
 /// `Columns::merged_into` of a column that has not merged.
@@ -51,6 +73,48 @@ impl Columns {
     /// One more than the largest wall vertex of any column (a size for per-vertex arrays).
     pub fn wall_vertex_count(&self) -> usize {
         self.wall_vertex.iter().max().map_or(0, |&v| v as usize + 1)
+    }
+
+    /// Add a live column; returns its index.
+    pub fn push(&mut self, start: ColumnStart) -> u32 {
+        let c = self.len() as u32;
+        self.base.push(start.base);
+        self.dir.push(start.dir);
+        self.scale.push(start.scale);
+        self.node.push(start.node);
+        self.alive.push(true);
+        self.layers.push(start.layers);
+        self.wall_vertex.push(start.wall_vertex);
+        self.merged_into.push(NOT_MERGED);
+        self.slide.push(start.slide);
+        self.isotropic_ratio.push(f64::NAN);
+        self.isotropic_size.push(f64::NAN);
+        self.last_step.push(start.last_step);
+        self.max_step_ratio.push(0.0);
+        self.spec.push(start.spec);
+        c
+    }
+
+    /// How far column `c` should be from the wall after `k` layers; `None` once its stack is
+    /// complete (or when it has none).
+    pub fn distance(&self, c: usize, k: u32) -> Option<f64> {
+        self.spec[c].filter(|s| k <= s.max_count()).map(|s| s.distance(k))
+    }
+
+    /// The most layers column `c` may get (`None`: no layers).
+    pub fn target(&self, c: usize) -> Option<u32> {
+        self.spec[c].map(|s| s.max_count())
+    }
+
+    /// Column `c`'s stack ends where its cells become isotropic (`count = "auto"`).
+    pub fn stops_when_isotropic(&self, c: usize) -> bool {
+        self.spec[c].is_some_and(|s| s.fixed_count().is_none())
+    }
+
+    /// Whether `a` and `b` start from the same wall point (copies of a vertex in a fan): the
+    /// edge between them has no length on the wall and opens with the distance.
+    pub fn is_fan_edge(&self, a: usize, b: usize) -> bool {
+        self.base[a] == self.base[b]
     }
 
     /// The column that carries `c` on: itself, or the last one of its chain of merges.
@@ -138,6 +202,23 @@ impl Front {
         self.index_columns(carrier.len());
     }
 
+    /// Replace face `f` by `parts` (column lists of 3 or 4, in `f`'s orientation), which keep
+    /// its patch, wall triangle and raised state. The adjacency must be rebuilt after.
+    pub fn subdivide_face(&mut self, f: usize, parts: &[Vec<u32>]) {
+        let Some((first, rest)) = parts.split_first() else { return };
+        let (patch, raised, wall_triangle) = (self.patch[f], self.raised[f], self.wall_triangle[f]);
+        let mut c = [0; 4];
+        c[..first.len()].copy_from_slice(first);
+        self.columns[f] = c;
+        self.sizes[f] = first.len() as u8;
+        for part in rest {
+            let wall = (wall_triangle != u32::MAX).then_some(wall_triangle);
+            self.push(part, patch, wall);
+            let g = self.len() - 1;
+            self.raised[g] = raised;
+        }
+    }
+
     /// Keep only the faces of the patches `keep` accepts (before marching) and rebuild the
     /// adjacency.
     pub fn retain_patches(&mut self, keep: impl Fn(u32) -> bool, column_count: usize) {
@@ -184,8 +265,8 @@ impl Front {
     }
 
     /// The front's tangential size at every column: the mean length of the front edges at the
-    /// columns of its wall vertex (NaN if there are none). Edges between two copies of one wall
-    /// vertex (fan edges) are left out: they measure the opening of a fan, which grows with the
+    /// columns of its wall vertex (NaN if there are none). Fan edges
+    /// ([`Columns::is_fan_edge`]) are left out: they measure the opening of a fan, which grows with the
     /// distance until tangential refinement splits it; so all the columns of a vertex, corner
     /// webs included, get the size of the front along the wall. An edge inside the front counts
     /// once from each face.
@@ -196,7 +277,7 @@ impl Front {
         for (a, b) in self.edges() {
             let (va, vb) = (columns.wall_vertex[a] as usize, columns.wall_vertex[b] as usize);
             let length = points[columns.node[a] as usize].distance(points[columns.node[b] as usize]);
-            if length > 0.0 && va != vb {
+            if length > 0.0 && !columns.is_fan_edge(a, b) {
                 for v in [va, vb] {
                     sum[v] += length;
                     count[v] += 1;
@@ -217,27 +298,31 @@ impl Front {
 
     /// Are columns `a` and `b` the two ends of a front edge?
     pub fn are_neighbours(&self, a: u32, b: u32) -> bool {
-        self.faces_of(a).any(|f| {
-            let cols = self.face_columns(f);
-            let n = cols.len();
-            (0..n).any(|i| cols[i] == a && (cols[(i + 1) % n] == b || cols[(i + n - 1) % n] == b))
-        })
+        let mut next = Vec::new();
+        self.neighbours(a as usize, &mut next);
+        next.contains(&(b as usize))
     }
 
     /// How many distinct front neighbours of column `c` grow from wall vertex `v`.
     pub fn neighbours_of_vertex(&self, c: u32, v: u32, columns: &Columns) -> usize {
-        let mut found: Vec<u32> = Vec::new();
-        for f in self.faces_of(c) {
+        let mut next = Vec::new();
+        self.neighbours(c as usize, &mut next);
+        next.retain(|&x| columns.wall_vertex[x] == v);
+        next.sort_unstable();
+        next.dedup();
+        next.len()
+    }
+
+    /// Append the columns next to `c` along the front's edges to `out` (twice for an edge
+    /// inside the front).
+    pub fn neighbours(&self, c: usize, out: &mut Vec<usize>) {
+        for f in self.faces_of(c as u32) {
             let cols = self.face_columns(f);
             let n = cols.len();
-            let Some(i) = cols.iter().position(|&x| x == c) else { continue };
-            for x in [cols[(i + 1) % n], cols[(i + n - 1) % n]] {
-                if columns.wall_vertex[x as usize] == v && !found.contains(&x) {
-                    found.push(x);
-                }
+            if let Some(i) = cols.iter().position(|&x| x as usize == c) {
+                out.extend([cols[(i + 1) % n] as usize, cols[(i + n - 1) % n] as usize]);
             }
         }
-        found.len()
     }
 
     /// The faces touching any of `columns`, each once.
@@ -253,21 +338,19 @@ impl Front {
 /// the columns of their corners, and the fan faces.
 pub fn initial_front(surface: &Surface, normals: &WallNormals) -> (Columns, Front) {
     let mut columns = Columns::default();
-    for seed in &normals.columns {
-        columns.base.push(surface.points[seed.vertex as usize]);
-        columns.dir.push(seed.direction);
-        columns.scale.push(seed.scale);
-        columns.node.push(seed.vertex);
-        columns.alive.push(true);
-        columns.layers.push(0);
-        columns.wall_vertex.push(seed.vertex);
-        columns.merged_into.push(NOT_MERGED);
-        columns.isotropic_ratio.push(f64::NAN);
-        columns.last_step.push(0.0);
-        columns.max_step_ratio.push(0.0);
+    for (c, seed) in normals.columns.iter().enumerate() {
+        columns.push(ColumnStart {
+            base: surface.points[seed.vertex as usize],
+            dir: seed.direction,
+            scale: seed.scale,
+            node: seed.vertex,
+            layers: 0,
+            wall_vertex: seed.vertex,
+            slide: normals.slides.get(c).copied().unwrap_or_default(),
+            spec: None,
+            last_step: 0.0,
+        });
     }
-    columns.slide = normals.slides.clone();
-    columns.slide.resize(columns.len(), Slide::Free);
     let mut front = Front::default();
     for (t, corner_columns) in normals.triangle_columns.iter().enumerate() {
         front.push(corner_columns, surface.triangle_patch[t], Some(t as u32));

@@ -17,6 +17,7 @@ use super::entropy;
 use super::front::{Columns, Front};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
+use super::split::{self, Adapt, Sizes, Splits, NONE};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::CellPoints;
@@ -37,6 +38,11 @@ pub struct MarchStats {
     pub collapses: usize,
     /// Times the crossing guard searched the whole front for candidate pairs.
     pub guard_rebuilds: usize,
+    /// Front edges split (a column born at each one's middle).
+    pub splits: usize,
+    /// Long front edges left unsplit for a layer because the split would have made an invalid
+    /// cell.
+    pub splits_given_up: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -231,54 +237,83 @@ fn cut_from(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32) -
     }
 }
 
+/// The cell over front face `f` under a slab plan, with its active splits; the new column of
+/// split `s` proposes the node `committed + columns.len() + s`.
+fn face_cell(
+    front: &Front,
+    f: usize,
+    plan: &SlabPlan,
+    splits: &Splits,
+    columns: &Columns,
+    committed: u32,
+) -> SlabCell {
+    let (b, t, n, merging) = face_nodes(front, f, plan, columns, committed);
+    match splits.active_on_face(f, plan) {
+        None => slab_cell(&b[..n], &t[..n], merging),
+        Some(on_edge) => {
+            let first = committed + columns.len() as u32;
+            let mids = on_edge.map(|s| if s == NONE { NONE } else { first + s });
+            split::split_cell(&b[..n], &t[..n], &mids[..n], merging)
+        }
+    }
+}
+
 /// March `layers` steps (or until every column has stopped), appending points and cells to
-/// `mesh`. `distance(c, k)` is how far column `c` should be from the wall after `k` layers, or
-/// `None` when its stack is complete. Columns with `stop_when_isotropic[c]` also end their stack
-/// before the first layer whose height would reach the front's edge length around them
-/// (`count = "auto"`); they are marked in `columns.isotropic_ratio`.
+/// `mesh`. `columns.distance(c, k)` is how far column `c` should be from the wall after `k`
+/// layers, or `None` when its stack is complete. Columns that stop when isotropic also end their
+/// stack before the first layer whose height would reach the front's edge length around them
+/// (`count = "auto"`); they are marked in `columns.isotropic_ratio`. Unless `sizes.adapt` is
+/// off, front edges
+/// that grow too long for `sizes` are split ([`super::split`]), which adds columns.
 pub fn march(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
     max_layers: u32,
-    distance: impl Fn(usize, u32) -> Option<f64> + Sync,
-    stop_when_isotropic: &[bool],
+    sizes: &mut Sizes,
     mut on_layer: impl FnMut(u32),
 ) -> MarchStats {
     let mut stats = MarchStats::default();
     let mut guard = CrossingGuard::default();
-    let wall_size = front.mean_edge_length_at_columns(&mesh.points, columns);
     for k in 1..=max_layers {
         let _layer = tracing::debug_span!("layer", k).entered();
         for c in 0..columns.len() {
-            if columns.alive[c] && distance(c, k).is_none() {
+            if columns.alive[c] && columns.distance(c, k).is_none() {
                 columns.alive[c] = false;
             }
         }
-        if stop_when_isotropic.iter().any(|&s| s) {
-            stop_isotropic_columns(mesh, columns, front, k, &distance, stop_when_isotropic, &wall_size);
+        if (0..columns.len()).any(|c| columns.stops_when_isotropic(c)) {
+            let wall_size = matches!(sizes.adapt, Adapt::Off).then_some(sizes.wall.as_slice());
+            stop_isotropic_columns(mesh, columns, front, k, wall_size);
         }
         if !columns.alive.iter().any(|&a| a) {
             break;
         }
         let points = &mesh.points;
-        let proposed: Vec<DVec3> = (0..columns.len())
+        let mut proposed: Vec<DVec3> = (0..columns.len())
             .into_par_iter()
-            .map(|c| match (distance(c, k), distance(c, k - 1)) {
+            .map(|c| match (columns.distance(c, k), columns.distance(c, k - 1)) {
                 (Some(d), Some(d_before)) if columns.alive[c] => columns.slide[c].project(
                     points[columns.node[c] as usize] + columns.dir[c] * (columns.scale[c] * (d - d_before)),
                 ),
                 _ => DVec3::ZERO,
             })
             .collect();
-        let plan = settle_slab(mesh, columns, front, proposed, &mut guard, k, &distance);
+        let mut splits = match sizes.adapt {
+            Adapt::Off => Splits::default(),
+            Adapt::Wall | Adapt::Field(_) => split::propose(columns, front, &proposed, k, sizes),
+        };
+        proposed.extend_from_slice(&splits.top);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut splits, &mut guard, k);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses;
-        if plan.collapses > 0 || !plan.redirected.is_empty() {
+        let split_count = commit_slab(mesh, columns, front, &plan, &splits, sizes, k, &mut stats);
+        stats.splits += split_count;
+        stats.splits_given_up += splits.len() - split_count;
+        if plan.collapses > 0 || !plan.redirected.is_empty() || split_count > 0 {
             guard.invalidate();
         }
-        commit_slab(mesh, columns, front, &plan, &mut stats);
         stats.layers_marched = k;
         on_layer(k);
     }
@@ -287,31 +322,33 @@ pub fn march(
 }
 
 /// End the stacks of the columns whose next layer (the `k`-th) would be at least as high as the
-/// front's tangential size around them ([`Front::mean_edge_length_at_columns`]): its cells would
-/// be isotropic, which the core's tetrahedra do better. Where the front widens faster than the
-/// layers grow (convex walls coarser than the growth rate can follow, until tangential
-/// refinement splits their edges), the wall's own tangential size `wall_size` ends the stack
-/// instead.
+/// front's tangential size around them: its cells would be isotropic, which the core's
+/// tetrahedra do better. That size is the mean edge length at the column's wall vertex
+/// ([`Front::mean_edge_length_at_columns`]) graded over the front so that neighbours' sizes
+/// differ by at most the growth ratio ([`front_sizes`]): then neighbouring stacks end at most one
+/// layer apart (the cliff rule below seldom has to end a stack early). Where the front widens
+/// faster than the layers grow and is not split (`wall_size` given: convex walls coarser than
+/// the growth rate can follow), the wall's own tangential size ends the stack instead.
 fn stop_isotropic_columns(
     mesh: &VolumeMesh,
     columns: &mut Columns,
     front: &Front,
     k: u32,
-    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
-    stop_when_isotropic: &[bool],
-    wall_size: &[f64],
+    wall_size: Option<&[f64]>,
 ) {
-    let edge = front.mean_edge_length_at_columns(&mesh.points, columns);
+    let size = front_sizes(&mesh.points, columns, front);
     let ended = ended_neighbour_layers(columns, front);
     let ends = |c: usize| {
-        let (Some(d), Some(d_before)) = (distance(c, k), distance(c, k - 1)) else { return false };
+        let (Some(d), Some(d_before)) = (columns.distance(c, k), columns.distance(c, k - 1)) else {
+            return false;
+        };
         // A neighbour's stack ended more than one layer lower: end here too, so that the stacks
         // step down one layer at a time (no cliff in the final front).
         let cliff = ended[c] < columns.layers[c];
-        cliff || d - d_before >= edge[c].min(wall_size[c])
+        cliff || d - d_before >= wall_size.map_or(size[c], |w| size[c].min(w[c]))
     };
     let candidates: Vec<bool> =
-        (0..columns.len()).map(|c| columns.alive[c] && stop_when_isotropic[c]).collect();
+        (0..columns.len()).map(|c| columns.alive[c] && columns.stops_when_isotropic(c)).collect();
     // The columns of one wall vertex (a fan) end together: a fan strip cell with one side
     // stopped and the other moving would be flat.
     let mut vertex_ends = vec![false; columns.wall_vertex_count()];
@@ -322,11 +359,57 @@ fn stop_isotropic_columns(
         if candidates[c] && vertex_ends[columns.wall_vertex[c] as usize] {
             columns.alive[c] = false;
             // The last layer built, against the tangential size it ended at.
-            let (d_before, d_last) =
-                (distance(c, k - 1).unwrap_or(0.0), k.checked_sub(2).and_then(|j| distance(c, j)));
-            columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / edge[c];
+            let (d_before, d_last) = (
+                columns.distance(c, k - 1).unwrap_or(0.0),
+                k.checked_sub(2).and_then(|j| columns.distance(c, j)),
+            );
+            columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / size[c];
+            // What its neighbours are graded from: no more than the layer it did not build (a
+            // column may end with its wall vertex's others before its own size says so).
+            let refused = columns.distance(c, k).map_or(size[c], |d| d - d_before);
+            columns.isotropic_size[c] = size[c].min(refused);
         }
     }
+}
+
+/// The front's tangential size at every column for the isotropic stop: the mean edge length at
+/// its wall vertex (for a stack already ended: the size it ended at), lowered where a
+/// neighbour's size times a little less than the growth ratio is smaller. The columns of a
+/// wall vertex, which end together, share the smallest of their sizes.
+fn front_sizes(points: &[DVec3], columns: &Columns, front: &Front) -> Vec<f64> {
+    let mut size = front.mean_edge_length_at_columns(points, columns);
+    for (s, &ended) in size.iter_mut().zip(&columns.isotropic_size) {
+        if !ended.is_nan() {
+            *s = ended;
+        }
+    }
+    let mut by_vertex: Vec<u32> = (0..columns.len() as u32).collect();
+    by_vertex.sort_unstable_by_key(|&c| columns.wall_vertex[c as usize]);
+    let mut first = vec![0u32; columns.wall_vertex_count() + 1];
+    for &c in &by_vertex {
+        first[columns.wall_vertex[c as usize] as usize + 1] += 1;
+    }
+    for v in 0..first.len() - 1 {
+        first[v + 1] += first[v];
+    }
+    let siblings = |c: usize| {
+        let v = columns.wall_vertex[c] as usize;
+        by_vertex[first[v] as usize..first[v + 1] as usize].iter().map(|&s| s as usize)
+    };
+    let growth = |c: usize| columns.spec[c].map_or(f64::INFINITY, |s| s.growth);
+    let ratio = |a: usize, b: usize| {
+        if columns.wall_vertex[a] == columns.wall_vertex[b] {
+            1.0
+        } else {
+            growth(a).min(growth(b)).powf(super::GRADING_SHARE)
+        }
+    };
+    let neighbours = |c: usize, out: &mut Vec<usize>| {
+        front.neighbours(c, out);
+        out.extend(siblings(c));
+    };
+    super::graded_minimum(&mut size, neighbours, ratio);
+    size
 }
 
 /// For every column, the fewest layers of a neighbour (across a front edge) whose stack ended at
@@ -346,13 +429,7 @@ fn ended_neighbour_layers(columns: &Columns, front: &Front) -> Vec<u32> {
 /// Where every column will be at the end of the guard's horizon: after layer `k` if the slab
 /// has merged columns (they move to other columns' positions), else after the next
 /// [`LOOKAHEAD_LAYERS`] layers if it keeps moving (or its last layer, if that comes first).
-fn reach(
-    plan: &SlabPlan,
-    mesh: &VolumeMesh,
-    columns: &Columns,
-    k: u32,
-    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
-) -> Reach {
+fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach {
     let committed = mesh.points.len() as u32;
     let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
     if plan.collapses > 0 {
@@ -365,8 +442,8 @@ fn reach(
         .into_par_iter()
         .map(|c| {
             let node = mesh.points[columns.node[c] as usize];
-            let now = distance(c, k - 1);
-            let ahead = (k..=last).rev().find_map(|j| distance(c, j));
+            let now = columns.distance(c, k - 1);
+            let ahead = (k..=last).rev().find_map(|j| columns.distance(c, j));
             match (now, ahead) {
                 (Some(d0), Some(d1)) if plan.moving[c] => {
                     node + columns.dir[c] * (columns.scale[c] * (d1 - d0))
@@ -385,9 +462,9 @@ fn settle_slab(
     columns: &Columns,
     front: &Front,
     proposed: Vec<DVec3>,
+    splits: &mut Splits,
     guard: &mut CrossingGuard,
     k: u32,
-    distance: &(impl Fn(usize, u32) -> Option<f64> + Sync),
 ) -> SlabPlan {
     let mut plan = SlabPlan {
         moving: columns.alive.clone(),
@@ -402,9 +479,9 @@ fn settle_slab(
         .filter(|&f| front.face_columns(f).iter().any(|&c| plan.moving[c as usize]))
         .collect();
     loop {
-        repair_invalid_cells(&mut plan, mesh, columns, front, to_check);
+        repair_invalid_cells(&mut plan, splits, mesh, columns, front, to_check);
         if guard.is_stale(k, &plan) {
-            guard.rebuild(&plan, mesh, columns, front, reach(&plan, mesh, columns, k, distance));
+            guard.rebuild(&plan, mesh, columns, front, reach(&plan, mesh, columns, k));
         }
         let crossing = guard.crossing_faces(&plan, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
@@ -424,13 +501,14 @@ fn settle_slab(
     }
 }
 
-/// Check the cells over `to_check` and repair the invalid ones until every cell is valid: a
-/// collapse where a cell is being crushed, else stopping its columns. Collapses come first: an
-/// invalid cell without a crushed edge of its own may be mended by a collapse next to it (its
-/// neighbour crosses the bisector in another cell), so its columns stop only after a round that
-/// collapsed nothing.
+/// Check the cells over `to_check` and repair the invalid ones until every cell is valid: giving
+/// up their splits, else a collapse where a cell is being crushed, else stopping its columns.
+/// Collapses come first: an invalid cell without a crushed edge of its own may be mended by a
+/// collapse next to it (its neighbour crosses the bisector in another cell), so its columns stop
+/// only after a round that collapsed nothing.
 fn repair_invalid_cells(
     plan: &mut SlabPlan,
+    splits: &mut Splits,
     mesh: &VolumeMesh,
     columns: &Columns,
     front: &Front,
@@ -440,42 +518,45 @@ fn repair_invalid_cells(
     while !to_check.is_empty() {
         let invalid: Vec<usize> = {
             let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-            let plan = &*plan;
+            let (plan, splits) = (&*plan, &*splits);
             to_check
                 .par_iter()
                 .copied()
-                .filter(|&f| {
-                    let (b, t, n, merging) = face_nodes(front, f, plan, columns, committed);
-                    !proposal.cell_is_valid(&slab_cell(&b[..n], &t[..n], merging))
-                })
+                .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, splits, columns, committed)))
                 .collect()
         };
         let mut changed = Vec::new();
+        let mut changed_faces = Vec::new();
         let mut uncollapsed = Vec::new();
         for &f in &invalid {
+            let given_up = splits.give_up(f, plan);
+            if !given_up.is_empty() {
+                changed_faces.extend(given_up);
+                continue;
+            }
             match entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points) {
                 Some(merged) => changed.extend(merged),
                 None => uncollapsed.push(f),
             }
         }
-        if !changed.is_empty() {
-            // Only the cells around a merged column can change; the others wait for the round.
-            to_check = front.faces_around_columns(&changed);
-            to_check.extend(uncollapsed);
-            to_check.sort_unstable();
-            to_check.dedup();
-            continue;
-        }
-        for &f in &uncollapsed {
-            tracing::debug!(face = f, at = ?wall_points(front, f, columns), "invalid cell: stopping its columns");
-            for &c in front.face_columns(f) {
-                if plan.moving[plan.merges.root(c) as usize] {
-                    changed.extend(plan.stop(c));
+        if changed.is_empty() && changed_faces.is_empty() {
+            for &f in &uncollapsed {
+                tracing::debug!(face = f, at = ?wall_points(front, f, columns), "invalid cell: stopping its columns");
+                for &c in front.face_columns(f) {
+                    if plan.moving[plan.merges.root(c) as usize] {
+                        changed.extend(plan.stop(c));
+                    }
                 }
             }
+            uncollapsed.clear();
         }
-        // Only the cells around a column that stopped can change.
+        // Only the cells around a column that stopped or merged, or on a split given up, change;
+        // the invalid ones left wait for the next round.
         to_check = front.faces_around_columns(&changed);
+        to_check.extend(changed_faces);
+        to_check.extend(uncollapsed);
+        to_check.sort_unstable();
+        to_check.dedup();
     }
 }
 
@@ -485,20 +566,30 @@ fn wall_points(front: &Front, f: usize, columns: &Columns) -> Vec<(u32, [f32; 3]
     front.face_columns(f).iter().map(|&c| at(c)).collect()
 }
 
-/// Create the nodes of the moving columns, emit the slab's cells and apply the merges.
+/// Create the nodes of the moving columns and of the splits, emit the slab's cells, add the
+/// split columns and apply the merges; returns the number of splits made.
+#[allow(clippy::too_many_arguments)]
 fn commit_slab(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
     plan: &SlabPlan,
+    splits: &Splits,
+    sizes: &mut Sizes,
+    k: u32,
     stats: &mut MarchStats,
-) {
+) -> usize {
     let mut new_node = vec![u32::MAX; columns.len()];
     for c in 0..columns.len() {
         if plan.moving[c] && !plan.merges.is_merged(c as u32) {
             new_node[c] = mesh.points.len() as u32;
             mesh.points.push(plan.proposed[c]);
         }
+    }
+    let mut mid_node = vec![NONE; splits.len()];
+    for s in splits.active(plan) {
+        mid_node[s] = mesh.points.len() as u32;
+        mesh.points.push(splits.top[s]);
     }
     let top: Vec<u32> = (0..columns.len() as u32)
         .map(|c| {
@@ -515,7 +606,14 @@ fn commit_slab(
         .into_par_iter()
         .map(|f| {
             let (b, t, n, merging) = face_ends(front, f, columns, &plan.merges, |c| top[c as usize]);
-            (b[..n] != t[..n], slab_cell(&b[..n], &t[..n], merging))
+            let cell = match splits.active_on_face(f, plan) {
+                None => slab_cell(&b[..n], &t[..n], merging),
+                Some(on_edge) => {
+                    let mids = on_edge.map(|s| if s == NONE { NONE } else { mid_node[s as usize] });
+                    split::split_cell(&b[..n], &t[..n], &mids[..n], merging)
+                }
+            };
+            (b[..n] != t[..n], cell)
         })
         .collect();
     for (f, (moved, cell)) in cells.into_iter().enumerate() {
@@ -547,9 +645,16 @@ fn commit_slab(
         columns.dir[c as usize] = dir;
         columns.scale[c as usize] = scale;
     }
+    let old_count = columns.len() as u32;
+    let made = split::commit(splits, plan, &mid_node, k, columns, front, sizes);
     if plan.collapses > 0 {
-        front.apply_merges(plan.merges.roots());
+        let mut carrier = plan.merges.roots().to_vec();
+        carrier.extend(old_count..columns.len() as u32);
+        front.apply_merges(&carrier);
+    } else if made > 0 {
+        front.index_columns(columns.len());
     }
+    made
 }
 
 /// Remember column `c`'s new step and how it compares with the one before.

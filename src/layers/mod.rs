@@ -12,6 +12,7 @@ pub mod march;
 pub mod slab;
 pub mod sliding;
 pub mod smoothness;
+pub mod split;
 
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
@@ -20,6 +21,7 @@ use crate::normals::WallNormals;
 use crate::surface::Surface;
 
 pub use march::MarchStats;
+pub use split::Adapt;
 
 /// Name of the boundary patch made of the top faces of the layers.
 pub const TOP_PATCH: &str = "bl_top";
@@ -42,11 +44,13 @@ pub struct Layers {
 }
 
 /// Extrude the wall. `patch_spec[p]` is the layer stack of patch `p`, `None` for patches
-/// without layers (their vertices do not move).
+/// without layers (their vertices do not move). `adapt` says whether and to which sizes the
+/// front's edges are split while it marches.
 pub fn build_layers(
     surface: &Surface,
     normals: &WallNormals,
     patch_spec: &[Option<LayerSpec>],
+    adapt: Adapt,
     mut on_layer: impl FnMut(u32, u32),
 ) -> Layers {
     let (mut columns, mut front) = front::initial_front(surface, normals);
@@ -55,38 +59,37 @@ pub fn build_layers(
     front.retain_patches(layered, columns.len());
     let mut column_spec = column_specs(normals, &front, patch_spec);
     grade_first_heights(surface, &columns, &mut column_spec);
-    for (c, spec) in column_spec.iter().enumerate() {
-        columns.alive[c] = spec.is_some() && columns.slide[c] != Slide::Fixed;
+    columns.spec = column_spec;
+    for c in 0..columns.len() {
+        columns.alive[c] = columns.spec[c].is_some() && columns.slide[c] != Slide::Fixed;
     }
-    let target = |c: usize| column_spec[c].map(|s| s.max_count());
-    let auto: Vec<bool> = column_spec.iter().map(|s| s.is_some_and(|s| s.fixed_count().is_none())).collect();
-    let max_layers = (0..columns.len()).filter_map(target).max().unwrap_or(0);
+    let max_layers = (0..columns.len()).filter_map(|c| columns.target(c)).max().unwrap_or(0);
     let mut mesh = VolumeMesh {
         points: surface.points.clone(),
         zone_names: vec![LAYER_ZONE_NAME.to_owned()],
         ..Default::default()
     };
-    let distance =
-        |c: usize, k: u32| column_spec[c].filter(|_| k <= target(c).unwrap_or(0)).map(|s| s.distance(k));
-    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, distance, &auto, |k| {
+    let mut sizes = split::Sizes::new(adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
+    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, |k| {
         on_layer(k, max_layers)
     });
+    let front_edges = sizes.front_edge_lengths(&mesh.points, &columns, &front);
     add_boundary(&mut mesh, surface, &front, &columns);
     let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
     let reached: Vec<Option<f64>> = (0..columns.len())
         .map(|c| {
             let carrier = columns.carrier(c);
             let layers = columns.layers[carrier];
-            (layers > 0).then(|| distance(carrier, layers)).flatten()
+            (layers > 0).then(|| columns.distance(carrier, layers)).flatten()
         })
         .collect();
-    let smoothness = smoothness::measure(surface, &columns, &reached, growth);
+    let smoothness = smoothness::measure(surface, &columns, &reached, growth, front_edges);
     let mut vertex_layers: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut vertex_target: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut stopped_vertices = Vec::new();
     for c in 0..columns.len() {
         let v = columns.wall_vertex[c] as usize;
-        if let Some(t) = target(c) {
+        if let Some(t) = columns.target(c) {
             // A column that merged is carried on by the bisector column it merged into.
             let carrier = columns.carrier(c);
             let reached = columns.layers[carrier];
@@ -127,7 +130,7 @@ fn column_specs(
 }
 
 /// The share of the growth ratio (as an exponent) that neighbouring first heights may differ by.
-const GRADING_SHARE: f64 = 0.9;
+pub(crate) const GRADING_SHARE: f64 = 0.9;
 
 /// Where patches with different first heights meet, lower the larger ones near the border so
 /// that neighbouring wall vertices' first heights (and with equal counts and growth, their
@@ -160,29 +163,46 @@ fn grade_first_heights(surface: &Surface, columns: &front::Columns, column_spec:
             neighbours[a as usize].push(b);
         }
     }
-    // Dijkstra on the multiplicative metric: settle the smallest height first.
-    let mut heap: std::collections::BinaryHeap<std::cmp::Reverse<(u64, u32)>> = (0..n as u32)
-        .filter(|&v| height[v as usize].is_finite())
-        .map(|v| std::cmp::Reverse((height[v as usize].to_bits(), v)))
-        .collect();
-    while let Some(std::cmp::Reverse((bits, v))) = heap.pop() {
-        let h = f64::from_bits(bits);
-        if h > height[v as usize] {
-            continue;
-        }
-        for &w in &neighbours[v as usize] {
-            let w = w as usize;
-            // A little under r: the thickness of curved fronts varies a little more than h0.
-            let limit = h * growth[w].min(growth[v as usize]).powf(GRADING_SHARE);
-            if height[w].is_finite() && limit < height[w] {
-                height[w] = limit;
-                heap.push(std::cmp::Reverse((limit.to_bits(), w as u32)));
-            }
-        }
-    }
+    // A little under r: the thickness of curved fronts varies a little more than h0.
+    graded_minimum(
+        &mut height,
+        |v, out| out.extend(neighbours[v].iter().map(|&w| w as usize)),
+        |v, w| growth[w].min(growth[v]).powf(GRADING_SHARE),
+    );
     for (c, spec) in column_spec.iter_mut().enumerate() {
         if let Some(s) = spec {
             s.first_height = s.first_height.min(height[columns.wall_vertex[c] as usize]);
+        }
+    }
+}
+
+/// Lower `values` so that no value exceeds a neighbour's times `ratio(neighbour, it)`: the
+/// largest such field under the given one (a graded minimum, by Dijkstra's order: smallest
+/// first). Values that are not finite stay as they are and constrain nothing.
+/// `neighbours(v, out)` appends the neighbours of `v` to `out`.
+pub(crate) fn graded_minimum(
+    values: &mut [f64],
+    neighbours: impl Fn(usize, &mut Vec<usize>),
+    ratio: impl Fn(usize, usize) -> f64,
+) {
+    use std::cmp::Reverse;
+    let mut heap: std::collections::BinaryHeap<Reverse<(u64, usize)>> = (0..values.len())
+        .filter(|&v| values[v].is_finite() && values[v] >= 0.0)
+        .map(|v| Reverse((values[v].to_bits(), v)))
+        .collect();
+    let mut around = Vec::new();
+    while let Some(Reverse((bits, v))) = heap.pop() {
+        if f64::from_bits(bits) > values[v] {
+            continue;
+        }
+        around.clear();
+        neighbours(v, &mut around);
+        for &w in &around {
+            let limit = values[v] * ratio(v, w);
+            if values[w].is_finite() && limit < values[w] {
+                values[w] = limit;
+                heap.push(Reverse((limit.to_bits(), w)));
+            }
         }
     }
 }

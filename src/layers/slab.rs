@@ -110,6 +110,14 @@ pub struct Merging {
     pub cut_from_first: u8,
 }
 
+impl Merging {
+    /// How the lateral face over edge `(i, i + 1)` is cut: `None` not at all, `Some(true)` from
+    /// column `i`'s bottom, `Some(false)` from column `i + 1`'s.
+    pub fn cut_of(&self, i: usize) -> Option<bool> {
+        (self.cut & (1 << i) != 0).then_some(self.cut_from_first & (1 << i) != 0)
+    }
+}
+
 /// The outward faces of the cell over a front face with `bottom` and `top` node ids
 /// (the front face `bottom` is oriented with its right-hand normal pointing up, into the fluid).
 /// Faces that come twice with opposite orientations (halves of cut quads lying on each other)
@@ -122,9 +130,7 @@ pub fn slab_faces(bottom: &[u32], top: &[u32], merging: Merging) -> Vec<Polygon>
     faces.extend(Polygon::dedup(top));
     for i in 0..n {
         let j = (i + 1) % n;
-        let quad = [bottom[i], bottom[j], top[j], top[i]];
-        let cut = (merging.cut & (1 << i) != 0).then_some(merging.cut_from_first & (1 << i) != 0);
-        push_lateral(&mut faces, quad, cut);
+        push_lateral(&mut faces, [bottom[i], bottom[j], top[j], top[i]], merging.cut_of(i));
     }
     remove_opposite_pairs(&mut faces);
     faces
@@ -132,7 +138,7 @@ pub fn slab_faces(bottom: &[u32], top: &[u32], merging: Merging) -> Vec<Polygon>
 
 /// The lateral face `(b_i, b_j, t_j, t_i)` over a front edge; a twisted quad (`cut` given) is cut
 /// along the diagonal from `b_i` (`Some(true)`) or `b_j` (`Some(false)`).
-fn push_lateral(faces: &mut Vec<Polygon>, quad: [u32; 4], cut: Option<bool>) {
+pub fn push_lateral(faces: &mut Vec<Polygon>, quad: [u32; 4], cut: Option<bool>) {
     let Some(face) = Polygon::dedup(&quad) else { return };
     let (true, Some(from_i)) = (face.is_quad(), cut) else {
         faces.push(face);
@@ -144,7 +150,7 @@ fn push_lateral(faces: &mut Vec<Polygon>, quad: [u32; 4], cut: Option<bool>) {
 }
 
 /// Remove every pair of faces that are the same polygon with opposite orientations.
-fn remove_opposite_pairs(faces: &mut Vec<Polygon>) {
+pub fn remove_opposite_pairs(faces: &mut Vec<Polygon>) {
     let mut i = 0;
     while i < faces.len() {
         let reversed = faces[i].reversed();
@@ -170,14 +176,23 @@ pub fn slab_cell(bottom: &[u32], top: &[u32], merging: Merging) -> SlabCell {
         }
     }
     let faces = slab_faces(bottom, top, merging);
+    if merged != 0 {
+        if faces.len() < 4 {
+            return SlabCell::Flat;
+        }
+        return SlabCell::Split { apex: cone_apex(&faces, bottom, merged), faces };
+    }
+    cell_from_faces(faces)
+}
+
+/// The cell enclosed by `faces` (outward polygons): the standard shape they make, a polyhedron
+/// to split from its centre, or flat when they enclose no volume.
+pub fn cell_from_faces(faces: Vec<Polygon>) -> SlabCell {
     let mut distinct: Vec<u32> = faces.iter().flat_map(|f| f.nodes().iter().copied()).collect();
     distinct.sort_unstable();
     distinct.dedup();
     if faces.len() < 4 || distinct.len() < 4 {
         return SlabCell::Flat;
-    }
-    if merged != 0 {
-        return SlabCell::Split { apex: cone_apex(&faces, bottom, merged), faces };
     }
     let quads = faces.iter().filter(|f| f.is_quad()).count();
     let tris = faces.len() - quads;

@@ -6,6 +6,7 @@
 use serde::Serialize;
 
 use super::front::Columns;
+use super::split::SPLIT_LENGTH;
 use crate::surface::Surface;
 
 /// A distribution of ratios: quantiles, the largest, and the fraction within a tolerance band.
@@ -55,13 +56,26 @@ pub struct Smoothness {
     /// front's tangential size when it ended ([`Front::mean_edge_length_at_columns`]; band
     /// [1/r, r]).
     pub isotropy_ratio: RatioStats,
+    /// Over the edges of the final front: their length in the metric the front is split to
+    /// (the sizing field's, else the wall's tangential size where their columns started; band
+    /// [1/sqrt 2, sqrt 2]).
+    pub front_edge_length: RatioStats,
+    /// The same over the fan edges alone (between copies of one wall vertex).
+    pub fan_edge_length: RatioStats,
 }
 
 /// Measure the layers' smoothness. `reached[c]` is the wall distance column `c`'s stack reached
 /// (`None` without layers): the march puts every top at its stack's distance from the wall (a
 /// bisector column too, not its longer path along the bisector). `growth` is the (largest)
-/// growth ratio, for the bands.
-pub fn measure(surface: &Surface, columns: &Columns, reached: &[Option<f64>], growth: f64) -> Smoothness {
+/// growth ratio, for the bands. `front_edges` are the metric lengths of the final front's edges
+/// and of its fan edges ([`super::split::Sizes::front_edge_lengths`]).
+pub fn measure(
+    surface: &Surface,
+    columns: &Columns,
+    reached: &[Option<f64>],
+    growth: f64,
+    front_edges: (Vec<f64>, Vec<f64>),
+) -> Smoothness {
     let thickness = vertex_thickness(surface, columns, reached);
     let mut edges: Vec<[u32; 2]> = surface
         .triangles
@@ -87,6 +101,8 @@ pub fn measure(surface: &Surface, columns: &Columns, reached: &[Option<f64>], gr
         patch_border_thickness_ratio: RatioStats::of(at_border, 1.0, growth * (1.0 + 1e-9)),
         layer_height_ratio: RatioStats::of(steps, 1.0 / growth - 1e-9, growth * (1.0 + 1e-9)),
         isotropy_ratio: RatioStats::of(isotropy, 1.0 / growth, growth),
+        front_edge_length: RatioStats::of(front_edges.0, 1.0 / SPLIT_LENGTH, SPLIT_LENGTH),
+        fan_edge_length: RatioStats::of(front_edges.1, 1.0 / SPLIT_LENGTH, SPLIT_LENGTH),
     }
 }
 
