@@ -9,6 +9,7 @@ use std::time::{Duration, Instant};
 
 use blmesh::config::{LayerCount, LayerSettings, LayerSpec};
 use blmesh::layers::build_layers;
+use blmesh::layers::split::Adapt;
 use blmesh::normals::wall_normals;
 use blmesh::surface::features::Features;
 use blmesh::surface::topology::Topology;
@@ -37,7 +38,8 @@ fn main() {
     let mut cells = 0;
     for _ in 0..runs {
         let start = Instant::now();
-        let layers = build_layers(&surface, &normals, &patch_spec, |_, _| {});
+        // Tangential adaptivity as `blmesh mesh` runs it by default (no sizing field).
+        let layers = build_layers(&surface, &normals, &patch_spec, Adapt::Wall, |_, _| {});
         times.push(start.elapsed());
         cells = layers.mesh.cell_count();
     }
