@@ -303,16 +303,6 @@ impl Front {
         next.contains(&(b as usize))
     }
 
-    /// How many distinct front neighbours of column `c` grow from wall vertex `v`.
-    pub fn neighbours_of_vertex(&self, c: u32, v: u32, columns: &Columns) -> usize {
-        let mut next = Vec::new();
-        self.neighbours(c as usize, &mut next);
-        next.retain(|&x| columns.wall_vertex[x] == v);
-        next.sort_unstable();
-        next.dedup();
-        next.len()
-    }
-
     /// Append the columns next to `c` along the front's edges to `out` (twice for an edge
     /// inside the front).
     pub fn neighbours(&self, c: usize, out: &mut Vec<usize>) {

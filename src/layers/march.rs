@@ -185,14 +185,8 @@ fn face_ends(
     }
     for i in 0..n {
         let (a, c) = (cols[i], cols[(i + 1) % n]);
-        let from = if merges.is_merged(a) || merges.is_merged(c) {
-            Some(cut_from(front, merges, columns, a, c))
-        } else if columns.node[a as usize] == columns.wall_vertex[a as usize] {
-            closing_fan_cut(front, columns, a, c)
-        } else {
-            None
-        };
-        if let Some(from) = from {
+        if merges.is_merged(a) || merges.is_merged(c) {
+            let from = cut_from(front, merges, columns, a, c);
             merging.cut |= 1 << i;
             if from == a {
                 merging.cut_from_first |= 1 << i;
@@ -200,20 +194,6 @@ fn face_ends(
         }
     }
     (b, t, n, merging)
-}
-
-/// Where a convex ridge ends at a vertex with a single column `q` (a fin's leading edge meeting
-/// a body), the fan of the ridge's other vertex closes onto `q`: the lateral faces between `q`
-/// and the fan copies `p` still at the wall turn with the fan while `q` stays put, so they are
-/// twisted. Cut them from the fan copy's (shared) wall node: the first cell over each fan
-/// triangle is then the tetrahedron between two fan directions and `q`'s top. Returns `p`.
-fn closing_fan_cut(front: &Front, columns: &Columns, a: u32, b: u32) -> Option<u32> {
-    [(a, b), (b, a)].into_iter().find_map(|(p, q)| {
-        let v = columns.wall_vertex[p as usize];
-        let at_wall = columns.node[p as usize] == v;
-        (at_wall && columns.wall_vertex[q as usize] != v && front.neighbours_of_vertex(q, v, columns) >= 3)
-            .then_some(p)
-    })
 }
 
 /// Which end of front edge `(a, b)` the twisted lateral face over it is cut from (see

@@ -13,9 +13,7 @@
 //! the lateral quads beside it twisted: their top edge runs towards the survivor, away from the
 //! bottom edge. Such a quad is cut into two triangles along the diagonal from the merged
 //! column's bottom node (when both merged, the caller picks one from the edge's two columns, see
-//! [`Merging`]), so both cells agree. (The first lateral faces of a fan that closes onto a single
-//! column, at the end of a convex ridge, are twisted the same way and cut too.) The cell over a
-//! front triangle with a merged column
+//! [`Merging`]), so both cells agree. The cell over a front triangle with a merged column
 //! is then a cone from that column's bottom node: no new point (the exact entropy picture: the
 //! merged characteristic ends there).
 //!
