@@ -112,7 +112,7 @@ struct MeshArgs {
     /// Write only the layers (no core tetrahedra).
     #[arg(long)]
     no_core: bool,
-    /// Do not split the layers' front edges that grow too long (tangential adaptivity).
+    /// Do not split or collapse the layers' front edges to the tangential sizes (tangential adaptivity).
     #[arg(long)]
     no_adapt: bool,
     /// Write MSH as ASCII instead of binary.

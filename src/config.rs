@@ -18,7 +18,7 @@
 //! role = "symmetry"            # wall | symmetry | farfield | inlet | outlet | none
 //! first_height = 2.0e-5        # per-patch layer overrides (wall patches), or yplus = ...
 //! [sizing]                     # tangential sizes the layers' front is split to
-//! adapt = true                 # split front edges that grow too long (default; --no-adapt)
+//! adapt = true                 # split/collapse front edges to the tangential sizes (default; --no-adapt)
 //! max_size = 0.5               # with max_size or regions: a sizing field (see `crate::sizing`)
 //! gradation = 1.2
 //! [[sizing.regions]]
@@ -200,12 +200,14 @@ pub struct SizingSettings {
 }
 
 impl SizingSettings {
-    /// Whether the front's edges are split as they grow: as the user says; by default only
-    /// against a sizing field the user gave. Against the wall's own sizes alone the splits cost
-    /// coverage at concave ridges (flange 0.42 -> 0.31, mech 0.37 -> 0.13 of the concave columns
-    /// at full thickness, measure.py, H = 1e-3 D, 10 layers), so they wait until they do not.
-    pub fn adapt(&self, has_field: bool) -> bool {
-        self.adapt.unwrap_or(has_field)
+    /// Whether the front's edges are split and collapsed to the tangential sizes as they march
+    /// (on unless the user turns it off): to the sizing field's sizes when there is one, else
+    /// to the wall's own. With the collapses and the edge-own wall length rule of
+    /// [`crate::layers::split::Sizes`], this raises coverage at concave ridges (H = 1e-3 D, 10
+    /// layers, full stacks at concave vertices: fandisk 68% -> 96%, flange 24% -> 88%, arrow
+    /// 1.5% -> 30%, bunny 2% -> 23%).
+    pub fn adapt(&self) -> bool {
+        self.adapt.unwrap_or(true)
     }
 
     /// The sizing field's spec when the user asked for one (a maximum size or regions), with the

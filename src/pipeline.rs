@@ -161,7 +161,7 @@ pub fn run(
         Some(spec) => Some(timings.time("sizing", || SizingField::new(&surface, &spec))?),
         None => None,
     };
-    let adapt = match (&sizing, config.sizing.adapt(sizing.is_some())) {
+    let adapt = match (&sizing, config.sizing.adapt()) {
         (_, false) => Adapt::Off,
         (Some(field), true) => Adapt::Field(field),
         (None, true) => Adapt::Wall,

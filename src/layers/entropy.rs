@@ -110,7 +110,7 @@ fn survivor(columns: &Columns, a: u32, b: u32) -> (u32, u32, bool) {
 }
 
 /// Merge roots `a` and `b` (see [`survivor`]).
-fn collapse(plan: &mut SlabPlan, columns: &Columns, a: u32, b: u32) {
+pub(super) fn collapse(plan: &mut SlabPlan, columns: &Columns, a: u32, b: u32) {
     let (sa, sb) = (columns.scale[a as usize], columns.scale[b as usize]);
     let at = |c: u32| columns.base[c as usize].as_vec3();
     tracing::debug!("collapse columns {a} at {} (scale {sa:.3}) and {b} at {} (scale {sb:.3})", at(a), at(b));

@@ -39,6 +39,9 @@ pub struct Columns {
     pub max_step_ratio: Vec<f64>,
     /// The column's layer stack (`None`: no layers).
     pub spec: Vec<Option<LayerSpec>>,
+    /// The layer the column starts at: 0 on the wall, the layer of its split for a column born
+    /// by a split.
+    pub born_at: Vec<u32>,
 }
 
 /// Where a new column starts and how it moves (see [`Columns::push`]).
@@ -92,6 +95,7 @@ impl Columns {
         self.last_step.push(start.last_step);
         self.max_step_ratio.push(0.0);
         self.spec.push(start.spec);
+        self.born_at.push(start.layers);
         c
     }
 
@@ -115,6 +119,12 @@ impl Columns {
     /// edge between them has no length on the wall and opens with the distance.
     pub fn is_fan_edge(&self, a: usize, b: usize) -> bool {
         self.base[a] == self.base[b]
+    }
+
+    /// The length on the wall of the front edge between `a` and `b` when both start on the wall
+    /// (zero for a fan edge), `None` when either was born by a split.
+    pub fn wall_edge_length(&self, a: usize, b: usize) -> Option<f64> {
+        (self.born_at[a] == 0 && self.born_at[b] == 0).then(|| self.base[a].distance(self.base[b]))
     }
 
     /// The column that carries `c` on: itself, or the last one of its chain of merges.

@@ -16,8 +16,9 @@ use rayon::prelude::*;
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
 use super::slab::Polygon;
+use super::split::{self, Splits, NONE};
 use crate::geometry::grid::overlapping_pairs_where;
-use crate::geometry::intersect::triangles_intersect;
+use crate::geometry::intersect::{folds_over_shared_edge, meet_beyond_shared_vertex, triangles_intersect};
 use crate::geometry::Aabb;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
@@ -57,10 +58,12 @@ impl CrossingGuard {
         self.valid_through = None;
     }
 
-    /// Find the face pairs whose boxes, swept from the committed front to `reach`, overlap.
+    /// Find the face pairs whose boxes, swept from the committed front to `reach` (and holding
+    /// the tops of this slab's splits), overlap.
     pub fn rebuild(
         &mut self,
         plan: &SlabPlan,
+        splits: &Splits,
         mesh: &VolumeMesh,
         columns: &Columns,
         front: &Front,
@@ -79,6 +82,9 @@ impl CrossingGuard {
                     b.grow(start);
                     b.grow(end);
                 }
+                for s in splits.active_on_face(f, plan).into_iter().flatten().filter(|&s| s != NONE) {
+                    b.grow(splits.top[s as usize]);
+                }
                 if cols.len() == 4 {
                     // The pyramid cap's apex lies within half an edge of the quad's centre.
                     let pad = DVec3::splat(0.5 * b.diagonal());
@@ -88,10 +94,13 @@ impl CrossingGuard {
             })
             .collect();
         let (boxes, moving): (Vec<Aabb>, Vec<bool>) = swept.into_iter().unzip();
-        // Two triangles sharing a column share a top vertex: the cells' validity judges them.
+        // Two triangles sharing an edge have a slab cell each on it, whose validity judges a
+        // fold between them; triangles sharing only a column can fold over each other with
+        // every cell valid (thin triangles of a front whose columns stopped at different
+        // layers), so they are tested beyond their shared vertex.
         let keep = |f: u32, g: u32| {
             let (a, b) = (front.face_columns(f as usize), front.face_columns(g as usize));
-            a.len() == 4 || b.len() == 4 || !a.iter().any(|c| b.contains(c))
+            a.len() == 4 || b.len() == 4 || a.iter().filter(|c| b.contains(c)).count() < 2
         };
         self.pairs = overlapping_pairs_where(&boxes, &moving, keep);
         self.valid_through = Some(reach.through_layer);
@@ -106,6 +115,7 @@ impl CrossingGuard {
     pub fn crossing_faces(
         &self,
         plan: &SlabPlan,
+        splits: &Splits,
         mesh: &VolumeMesh,
         columns: &Columns,
         front: &Front,
@@ -115,7 +125,7 @@ impl CrossingGuard {
         for &f in suspects {
             suspect[f] = true;
         }
-        let top = TopFront { plan, mesh, columns, front };
+        let top = TopFront { plan, splits, mesh, columns, front };
         // Most cached pairs are apart now: their current boxes sort them out cheaply.
         let boxes: Vec<Aabb> = (0..front.len()).into_par_iter().map(|f| top.cap_box(f)).collect();
         let tested: Vec<(u32, u32)> = self
@@ -152,6 +162,7 @@ impl CrossingGuard {
 /// The proposed top of the front faces under a slab plan.
 struct TopFront<'a> {
     plan: &'a SlabPlan,
+    splits: &'a Splits,
     mesh: &'a VolumeMesh,
     columns: &'a Columns,
     front: &'a Front,
@@ -180,41 +191,66 @@ impl TopFront<'_> {
         }
     }
 
+    /// Face `f`'s proposed top: its corners and, on its split edges, the splits' tops (node ids
+    /// as in [`super::march`]: split `s` proposes node `committed + columns.len() + s`), and
+    /// the split on each edge (or [`NONE`]) if it has any.
+    fn top(&self, f: usize) -> (Vec<(u32, DVec3)>, Option<[u32; 4]>) {
+        let mut top: Vec<(u32, DVec3)> =
+            self.front.face_columns(f).iter().map(|&c| self.node_and_position(c)).collect();
+        let on_edge = self.splits.active_on_face(f, self.plan);
+        let first = self.mesh.points.len() as u32 + self.columns.len() as u32;
+        let mids = on_edge.map(|e| e.map(|s| if s == NONE { NONE } else { first + s }));
+        for (s, id) in on_edge.into_iter().flatten().zip(mids.into_iter().flatten()) {
+            if s != NONE {
+                top.push((id, self.splits.top[s as usize]));
+            }
+        }
+        (top, mids)
+    }
+
     /// A box around face `f`'s proposed top and the cap it may get.
     fn cap_box(&self, f: usize) -> Aabb {
-        let cols = self.front.face_columns(f);
         let mut b = Aabb::empty();
-        for &c in cols {
-            b.grow(self.node_and_position(c).1);
+        for (_, p) in self.top(f).0 {
+            b.grow(p);
         }
-        if cols.len() < 4 {
+        if self.front.face_columns(f).len() < 4 {
             return b;
         }
         let pad = DVec3::splat(0.5 * b.diagonal());
         Aabb { min: b.min - pad, max: b.max + pad }
     }
 
+    /// The top's triangles: each part of a split top ([`split::subdivide`]) as a triangle, or
+    /// as the four triangles of its pyramid cap for a quad.
     fn shape(&self, f: usize) -> TopShape {
         let mut shape = TopShape::default();
-        let top: Vec<(u32, DVec3)> =
-            self.front.face_columns(f).iter().map(|&c| self.node_and_position(c)).collect();
-        let ids: Vec<u32> = top.iter().map(|t| t.0).collect();
-        let Some(polygon) = Polygon::dedup(&ids) else { return shape };
+        let (top, mids) = self.top(f);
+        let n = self.front.face_columns(f).len();
+        let ids: Vec<u32> = top[..n].iter().map(|t| t.0).collect();
         let at = |id: u32| top.iter().find(|t| t.0 == id).map_or(DVec3::ZERO, |t| t.1);
-        let n = polygon.nodes();
-        if n.len() == 3 {
-            shape.push([n[0], n[1], n[2]], [n[0], n[1], n[2]].map(at));
-            return shape;
-        }
-        let x = [0, 1, 2, 3].map(|i| at(n[i]));
-        let Some(apex) = pyramid_apex(x) else {
-            shape.uncappable = true;
-            return shape;
+        let parts = match mids {
+            Some(mids) => split::subdivide(&ids, &mids[..n]),
+            None => vec![ids],
         };
-        let apex_id = u32::MAX - f as u32;
-        for k in 0..4 {
-            let (a, b) = (k, (k + 1) % 4);
-            shape.push([n[a], n[b], apex_id], [x[a], x[b], apex]);
+        for (i, part) in parts.iter().enumerate() {
+            let Some(polygon) = Polygon::dedup(part) else { continue };
+            let n = polygon.nodes();
+            if n.len() == 3 {
+                shape.push([n[0], n[1], n[2]], [n[0], n[1], n[2]].map(at));
+                continue;
+            }
+            let x = [0, 1, 2, 3].map(|i| at(n[i]));
+            let Some(apex) = pyramid_apex(x) else {
+                shape.uncappable = true;
+                continue;
+            };
+            // An id of its own for each cap's apex, far above the node ids.
+            let apex_id = u32::MAX - (4 * f + i) as u32;
+            for k in 0..4 {
+                let (a, b) = (k, (k + 1) % 4);
+                shape.push([n[a], n[b], apex_id], [x[a], x[b], apex]);
+            }
         }
         shape
     }
@@ -227,15 +263,40 @@ impl TopShape {
         self.points.push(points);
     }
 
-    /// Whether a triangle of `self` and one of `other` that share no vertex touch (exact).
+    /// Whether a triangle of `self` and one of `other` meet where they should not (exact):
+    /// anywhere, for triangles that share no vertex; beyond the shared vertex, or folded over the
+    /// shared edge (faces that merged tops brought together, or a quad's cap against a
+    /// neighbour: no slab cell lies between them to judge such a fold).
     fn crosses(&self, other: &TopShape) -> bool {
         (0..self.ids.len()).any(|i| {
             (0..other.ids.len()).any(|j| {
-                !self.ids[i].iter().any(|v| other.ids[j].contains(v))
-                    && self.boxes[i].overlaps(&other.boxes[j])
-                    && triangles_intersect(self.points[i], other.points[j])
+                self.boxes[i].overlaps(&other.boxes[j])
+                    && triangles_meet(self.ids[i], self.points[i], other.ids[j], other.points[j])
             })
         })
+    }
+}
+
+/// Whether triangles `t` and `u` (node ids and points) meet elsewhere than in the vertices they
+/// share: see [`TopShape::crosses`].
+fn triangles_meet(t_ids: [u32; 3], t: [DVec3; 3], u_ids: [u32; 3], u: [DVec3; 3]) -> bool {
+    let shared_in_u = t_ids.map(|v| u_ids.iter().position(|&w| w == v));
+    match shared_in_u.iter().filter(|s| s.is_some()).count() {
+        0 => triangles_intersect(t, u),
+        1 => {
+            let i = shared_in_u.iter().position(|s| s.is_some()).unwrap_or(0);
+            let j = shared_in_u[i].unwrap_or(0);
+            let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
+            let (c, d) = (u[(j + 1) % 3], u[(j + 2) % 3]);
+            meet_beyond_shared_vertex(t[i], a, b, c, d)
+        }
+        2 => {
+            let lone_t = shared_in_u.iter().position(|s| s.is_none()).unwrap_or(0);
+            let lone_u = (0..3).find(|&k| !t_ids.contains(&u_ids[k])).unwrap_or(0);
+            let (v, w) = (t[(lone_t + 1) % 3], t[(lone_t + 2) % 3]);
+            folds_over_shared_edge(v, w, t[lone_t], u[lone_u])
+        }
+        _ => false,
     }
 }
 
@@ -297,6 +358,7 @@ mod tests {
                 merges: Merges::new(6),
                 redirected: Vec::new(),
                 collapses: 0,
+                coarsened: 0,
             };
             if guard.is_stale(k, &plan) {
                 let end: Vec<DVec3> = (0..6)
@@ -307,13 +369,14 @@ mod tests {
                     .collect();
                 guard.rebuild(
                     &plan,
+                    &Splits::default(),
                     &mesh,
                     &columns,
                     &front,
                     Reach { end, through_layer: k + LOOKAHEAD_LAYERS - 1 },
                 );
             }
-            crossings.push(guard.crossing_faces(&plan, &mesh, &columns, &front, &[0, 1]));
+            crossings.push(guard.crossing_faces(&plan, &Splits::default(), &mesh, &columns, &front, &[0, 1]));
             for (c, p) in proposed.into_iter().enumerate() {
                 columns.node[c] = mesh.points.len() as u32;
                 mesh.points.push(p);

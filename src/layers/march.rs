@@ -13,11 +13,11 @@
 use rayon::prelude::*;
 
 use super::collapse::Merges;
-use super::entropy;
 use super::front::{Columns, Front};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
 use super::split::{self, Adapt, Sizes, Splits, NONE};
+use super::{coarsen, entropy};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::CellPoints;
@@ -40,6 +40,8 @@ pub struct MarchStats {
     pub guard_rebuilds: usize,
     /// Front edges split (a column born at each one's middle).
     pub splits: usize,
+    /// Short front edges collapsed to the tangential size (two columns merged into one).
+    pub tangential_collapses: usize,
     /// Long front edges left unsplit for a layer because the split would have made an invalid
     /// cell.
     pub splits_given_up: usize,
@@ -124,7 +126,10 @@ pub(super) struct SlabPlan {
     pub merges: Merges,
     /// New direction and scale of survivors placed between the two columns they merged.
     pub redirected: Vec<(u32, DVec3, f64)>,
+    /// Merges made, entropy and tangential.
     pub collapses: usize,
+    /// Of those, the tangential collapses of short edges ([`super::coarsen`]).
+    pub coarsened: usize,
 }
 
 impl SlabPlan {
@@ -284,10 +289,11 @@ pub fn march(
             Adapt::Wall | Adapt::Field(_) => split::propose(columns, front, &proposed, k, sizes),
         };
         proposed.extend_from_slice(&splits.top);
-        let plan = settle_slab(mesh, columns, front, proposed, &mut splits, &mut guard, k);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut splits, sizes, &mut guard, k);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
-        stats.collapses += plan.collapses;
+        stats.collapses += plan.collapses - plan.coarsened;
+        stats.tangential_collapses += plan.coarsened;
         let split_count = commit_slab(mesh, columns, front, &plan, &splits, sizes, k, &mut stats);
         stats.splits += split_count;
         stats.splits_given_up += splits.len() - split_count;
@@ -436,13 +442,16 @@ fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach
 }
 
 /// Decide which columns move and merge so that every cell of the slab is valid and the new
-/// front does not cross itself.
+/// front does not cross itself: first the tangential collapses of short edges (unless
+/// adaptivity is off), then the repairs of invalid cells and of crossings.
+#[allow(clippy::too_many_arguments)]
 fn settle_slab(
     mesh: &VolumeMesh,
     columns: &Columns,
     front: &Front,
     proposed: Vec<DVec3>,
     splits: &mut Splits,
+    sizes: &Sizes,
     guard: &mut CrossingGuard,
     k: u32,
 ) -> SlabPlan {
@@ -452,7 +461,19 @@ fn settle_slab(
         merges: Merges::new(columns.len()),
         redirected: Vec::new(),
         collapses: 0,
+        coarsened: 0,
     };
+    if !matches!(sizes.adapt, Adapt::Off) {
+        let committed = mesh.points.len() as u32;
+        let splits = &*splits;
+        plan.coarsened = coarsen::collapse_short_edges(&mut plan, front, columns, sizes, |plan, group| {
+            let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+            front
+                .faces_around_columns(group)
+                .into_iter()
+                .all(|f| proposal.cell_is_valid(&face_cell(front, f, plan, splits, columns, committed)))
+        });
+    }
     let mut to_check: Vec<usize> = (0..front.len()).collect();
     // Two faces that do not move cannot start to cross: only moving ones are suspects.
     let mut suspects: Vec<usize> = (0..front.len())
@@ -461,9 +482,9 @@ fn settle_slab(
     loop {
         repair_invalid_cells(&mut plan, splits, mesh, columns, front, to_check);
         if guard.is_stale(k, &plan) {
-            guard.rebuild(&plan, mesh, columns, front, reach(&plan, mesh, columns, k));
+            guard.rebuild(&plan, splits, mesh, columns, front, reach(&plan, mesh, columns, k));
         }
-        let crossing = guard.crossing_faces(&plan, mesh, columns, front, &suspects);
+        let crossing = guard.crossing_faces(&plan, splits, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
         for f in crossing {
             tracing::debug!(face = f, at = ?wall_points(front, f, columns), "the new front crosses itself: stopping the face's columns");

@@ -18,6 +18,19 @@ pub struct RatioStats {
     pub max: f64,
     /// Fraction of the ratios within the band given where it is computed.
     pub within_band: f64,
+    /// Counts in bins between powers of sqrt(2): bin `i` holds the ratios in
+    /// `[sqrt2^(i-5), sqrt2^(i-4))` for `i` in 1..=8, bin 0 those below 1/4 and bin 9 those
+    /// from 4 up (so bins 4 and 5 are [1/sqrt 2, 1) and [1, sqrt 2)).
+    pub histogram: [usize; HISTOGRAM_BINS],
+}
+
+/// Bins of [`RatioStats::histogram`].
+pub const HISTOGRAM_BINS: usize = 10;
+
+/// The histogram bin of a ratio (see [`RatioStats::histogram`]).
+fn histogram_bin(r: f64) -> usize {
+    let i = (2.0 * r.log2()).floor() + 5.0;
+    i.clamp(0.0, (HISTOGRAM_BINS - 1) as f64) as usize
 }
 
 impl RatioStats {
@@ -30,12 +43,17 @@ impl RatioStats {
         ratios.sort_by(f64::total_cmp);
         let at = |q: f64| ratios[((ratios.len() - 1) as f64 * q).round() as usize];
         let within = ratios.iter().filter(|&&r| (lo..=hi).contains(&r)).count();
+        let mut histogram = [0; HISTOGRAM_BINS];
+        for &r in &ratios {
+            histogram[histogram_bin(r)] += 1;
+        }
         RatioStats {
             count: ratios.len(),
             median: at(0.5),
             p95: at(0.95),
             max: at(1.0),
             within_band: within as f64 / ratios.len() as f64,
+            histogram,
         }
     }
 }
@@ -147,5 +165,14 @@ mod tests {
         assert_eq!(s.max, 1.5);
         assert!((s.within_band - 0.75).abs() < 1e-12);
         assert_eq!(RatioStats::of(vec![], 1.0, 2.0).count, 0);
+        // 1.0, 1.1, 1.2 in [1, sqrt 2); 1.5 in [sqrt 2, 2).
+        assert_eq!(s.histogram, [0, 0, 0, 0, 0, 3, 1, 0, 0, 0]);
+    }
+
+    #[test]
+    fn histogram_bins_are_powers_of_sqrt2() {
+        let at = |r: f64| histogram_bin(r);
+        assert_eq!((at(0.01), at(0.25), at(0.5), at(0.7), at(0.71), at(0.99)), (0, 1, 3, 3, 4, 4));
+        assert_eq!((at(1.0), at(1.41), at(1.42), at(3.99), at(4.0), at(1e9)), (5, 5, 6, 8, 9, 9));
     }
 }

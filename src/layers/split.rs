@@ -19,7 +19,7 @@ use rayon::prelude::*;
 use super::front::{ColumnStart, Columns, Front};
 use super::march::SlabPlan;
 use super::slab::{self, cell_from_faces, Merging, Polygon, SlabCell};
-use crate::sizing::{Metric, SizingField};
+use crate::sizing::SizingField;
 
 /// Whether, and to which sizes, the front's edges are split while it marches.
 #[derive(Clone, Copy, Debug)]
@@ -40,6 +40,18 @@ pub const SPLIT_LENGTH: f64 = SQRT_2;
 pub const NONE: u32 = u32::MAX;
 
 /// The sizes the front's edges are measured against.
+///
+/// A front edge lies in the front, which follows the wall's offsets, so it is measured with
+/// the tangential size alone (the metric restricted to the front's tangent plane): the normal
+/// size, as small as the first layer, would turn the sagitta of a chord on a curved front into
+/// a "long" edge and split every edge of a sphere's first layers.
+///
+/// The layers do not refine or coarsen the wall's own resolution because it is irregular (a
+/// long thin wall triangle is the user's mesh, not a front that grew): an edge between two wall
+/// columns is split only once it is longer than `sqrt(2)` times both the target and its own
+/// length on the wall, and collapsed only once shorter than `1/sqrt(2)` times both. Fronts that
+/// widen (convex walls, fans, whose edges have no length on the wall) or compress (concave
+/// walls) and the user's own sizes (a sizing field's regions and maximum size) change it.
 pub struct Sizes<'a> {
     pub adapt: Adapt<'a>,
     field: Option<&'a SizingField>,
@@ -57,26 +69,65 @@ impl<'a> Sizes<'a> {
         Sizes { adapt, field, wall }
     }
 
-    /// The metric at `at[c]` for the columns with `wanted[c]` (only a sizing field needs them).
-    pub fn metrics(&self, at: &[DVec3], wanted: &[bool]) -> Vec<Metric> {
-        let Some(field) = self.field else { return Vec::new() };
+    /// The tangential size wanted at `at[c]` for the columns with `wanted[c]` (the others get
+    /// their wall size): the target of the front's edges.
+    pub fn tangential(&self, at: &[DVec3], wanted: &[bool]) -> Vec<f64> {
+        self.per_column(at, wanted, |field, x| field.tangential_size(x), |c| self.wall[c])
+    }
+
+    /// The user's size at `at[c]` for the columns with `wanted[c]` (infinite without a sizing
+    /// field, and for the others).
+    pub fn user(&self, at: &[DVec3], wanted: &[bool]) -> Vec<f64> {
+        self.per_column(at, wanted, |field, x| field.user_size(x), |_| f64::INFINITY)
+    }
+
+    fn per_column(
+        &self,
+        at: &[DVec3],
+        wanted: &[bool],
+        from_field: impl Fn(&SizingField, DVec3) -> f64 + Sync,
+        otherwise: impl Fn(usize) -> f64 + Sync,
+    ) -> Vec<f64> {
         (0..wanted.len())
             .into_par_iter()
-            .map(|c| if wanted[c] { field.metric(at[c]) } else { Metric::isotropic(1.0) })
+            .map(|c| match self.field {
+                Some(field) if wanted[c] => from_field(field, at[c]),
+                _ => otherwise(c),
+            })
             .collect()
     }
 
-    /// Metric length of the edge `e` between columns `a` and `b` (`metrics` from
-    /// [`Sizes::metrics`]): the mean of its lengths in the metrics at its ends.
-    pub fn edge_length(&self, metrics: &[Metric], a: usize, b: usize, e: DVec3) -> f64 {
-        match self.field {
-            Some(_) => 0.5 * (metrics[a].edge_length(e) + metrics[b].edge_length(e)),
-            None => e.length() * 0.5 * (1.0 / self.wall[a] + 1.0 / self.wall[b]),
-        }
+    /// Length of the edge `e` between columns `a` and `b` against the sizes `h` (from
+    /// [`Sizes::tangential`]): the mean of its lengths in the sizes at its ends.
+    pub fn edge_length(h: &[f64], a: usize, b: usize, e: DVec3) -> f64 {
+        e.length() / mean_size(h, a, b)
     }
 
-    /// The metric length of every edge of the raised front (zero-length edges left out), and of
-    /// its fan edges alone.
+    /// Length of front edge `e` between columns `a` and `b` against the size it is split at:
+    /// the target `h`, or where they are longer the edge's length on the wall and the layer's
+    /// height `height` (a front finer than its layers are high would only make flat cells),
+    /// but the user's size `user` where that is smaller.
+    pub fn split_length(
+        columns: &Columns,
+        [h, height, user]: [&[f64]; 3],
+        a: usize,
+        b: usize,
+        e: DVec3,
+    ) -> f64 {
+        let on_wall = columns.wall_edge_length(a, b).unwrap_or(0.0);
+        let size = mean_size(h, a, b).max(on_wall).max(mean_size(height, a, b));
+        e.length() / size.min(mean_size(user, a, b))
+    }
+
+    /// Length of front edge `e` between columns `a` and `b` against the size it is collapsed
+    /// at: the target `h`, or the edge's length on the wall where that is shorter.
+    pub fn collapse_length(columns: &Columns, h: &[f64], a: usize, b: usize, e: DVec3) -> f64 {
+        let on_wall = columns.wall_edge_length(a, b).unwrap_or(f64::INFINITY);
+        e.length() / mean_size(h, a, b).min(on_wall)
+    }
+
+    /// The length in the sizes of every edge of the raised front (zero-length edges left out),
+    /// and of its fan edges alone.
     pub fn front_edge_lengths(
         &self,
         points: &[DVec3],
@@ -84,7 +135,7 @@ impl<'a> Sizes<'a> {
         front: &Front,
     ) -> (Vec<f64>, Vec<f64>) {
         let at: Vec<DVec3> = columns.node.iter().map(|&n| points[n as usize]).collect();
-        let metrics = self.metrics(&at, &vec![true; columns.len()]);
+        let h = self.tangential(&at, &vec![true; columns.len()]);
         let (mut all, mut fan) = (Vec::new(), Vec::new());
         for f in (0..front.len()).filter(|&f| front.raised[f]) {
             let cols = front.face_columns(f);
@@ -92,7 +143,7 @@ impl<'a> Sizes<'a> {
                 let (a, b) = (cols[i] as usize, cols[(i + 1) % cols.len()] as usize);
                 let e = at[b] - at[a];
                 if a < b && e != DVec3::ZERO {
-                    let length = self.edge_length(&metrics, a, b, e);
+                    let length = Self::edge_length(&h, a, b, e);
                     all.push(length);
                     if columns.is_fan_edge(a, b) {
                         fan.push(length);
@@ -102,6 +153,12 @@ impl<'a> Sizes<'a> {
         }
         (all, fan)
     }
+}
+
+/// The size that measures an edge between columns `a` and `b` as the mean of its lengths in
+/// the sizes `h` at its ends (their harmonic mean; infinite sizes count as no limit).
+fn mean_size(h: &[f64], a: usize, b: usize) -> f64 {
+    2.0 / (1.0 / h[a] + 1.0 / h[b])
 }
 
 /// The splits proposed for one slab.
@@ -168,19 +225,23 @@ impl Splits {
 /// the new column at the middle of each. Only edges between two faces are split (an edge seen
 /// once borders a patch without layers), and only between columns that slide alike.
 pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], k: u32, sizes: &Sizes) -> Splits {
-    let metrics = sizes.metrics(proposed, &columns.alive);
+    let (h, user) = (sizes.tangential(proposed, &columns.alive), sizes.user(proposed, &columns.alive));
+    let height: Vec<f64> = (0..columns.len())
+        .map(|c| columns.distance(c, k).zip(columns.distance(c, k - 1)).map_or(0.0, |(d, e)| d - e))
+        .collect();
     let mut long: Vec<([u32; 2], u32, u8)> = (0..front.len())
         .into_par_iter()
         .flat_map_iter(|f| {
             let cols = front.face_columns(f);
             let n = cols.len();
-            let (metrics, proposed) = (&metrics, proposed);
+            let (sizes, proposed) = ([&h[..], &height[..], &user[..]], proposed);
             (0..n).filter_map(move |i| {
                 let (a, b) = (cols[i], cols[(i + 1) % n]);
                 let (ua, ub) = (a as usize, b as usize);
                 let live = columns.alive[ua] && columns.alive[ub];
-                let long =
-                    live && sizes.edge_length(metrics, ua, ub, proposed[ub] - proposed[ua]) > SPLIT_LENGTH;
+                let long = live
+                    && Sizes::split_length(columns, sizes, ua, ub, proposed[ub] - proposed[ua])
+                        > SPLIT_LENGTH;
                 long.then_some(([a.min(b), a.max(b)], f as u32, i as u8))
             })
         })
