@@ -94,13 +94,11 @@ impl CrossingGuard {
             })
             .collect();
         let (boxes, moving): (Vec<Aabb>, Vec<bool>) = swept.into_iter().unzip();
-        // Two triangles sharing an edge have a slab cell each on it, whose validity judges a
-        // fold between them; triangles sharing only a column can fold over each other with
-        // every cell valid (thin triangles of a front whose columns stopped at different
-        // layers), so they are tested beyond their shared vertex.
+        // Two triangles sharing a column share a top vertex: the cells' validity judges them
+        // (but next to a change of the front's topology, see `pairs_at_changes`).
         let keep = |f: u32, g: u32| {
             let (a, b) = (front.face_columns(f as usize), front.face_columns(g as usize));
-            a.len() == 4 || b.len() == 4 || a.iter().filter(|c| b.contains(c)).count() < 2
+            a.len() == 4 || b.len() == 4 || !a.iter().any(|c| b.contains(c))
         };
         self.pairs = overlapping_pairs_where(&boxes, &moving, keep);
         self.valid_through = Some(reach.through_layer);
@@ -132,6 +130,7 @@ impl CrossingGuard {
             .pairs
             .par_iter()
             .copied()
+            .chain(pairs_at_changes(plan, splits, front, suspects).into_par_iter())
             .filter(|&(f, g)| {
                 (suspect[f as usize] || suspect[g as usize]) && boxes[f as usize].overlaps(&boxes[g as usize])
             })
@@ -157,6 +156,39 @@ impl CrossingGuard {
         faces.dedup();
         faces
     }
+}
+
+/// The pairs of triangles sharing a column but no edge where one of them changes shape this
+/// slab (a column of it stops while another moves, merges, or has a split on its edge), among
+/// the `suspects`. A front moving as a whole cannot fold over a shared vertex without turning a
+/// cell between them inside out; where columns stop at different layers or merge, thin
+/// triangles can, with every cell valid, so these pairs are tested beyond their shared vertex.
+fn pairs_at_changes(plan: &SlabPlan, splits: &Splits, front: &Front, suspects: &[usize]) -> Vec<(u32, u32)> {
+    let changes = |f: usize| {
+        let cols = front.face_columns(f);
+        let moving = |c: u32| plan.moving[plan.merges.root(c) as usize];
+        let mixed = cols.iter().any(|&c| moving(c)) && cols.iter().any(|&c| !moving(c));
+        let merged = cols.iter().any(|&c| plan.merges.is_merged(c) || plan.merges.group(c).nth(1).is_some());
+        mixed || merged || splits.active_on_face(f, plan).is_some()
+    };
+    let mut pairs: Vec<(u32, u32)> = suspects
+        .par_iter()
+        .copied()
+        .filter(|&f| front.face_columns(f).len() == 3 && changes(f))
+        .flat_map_iter(|f| {
+            let cols = front.face_columns(f);
+            cols.iter()
+                .flat_map(move |&c| front.faces_of(c))
+                .filter(move |&g| {
+                    let other = front.face_columns(g);
+                    g != f && other.len() == 3 && other.iter().filter(|c| cols.contains(c)).count() == 1
+                })
+                .map(move |g| (f.min(g) as u32, f.max(g) as u32))
+        })
+        .collect();
+    pairs.par_sort_unstable();
+    pairs.dedup();
+    pairs
 }
 
 /// The proposed top of the front faces under a slab plan.
@@ -384,5 +416,26 @@ mod tests {
         }
         assert_eq!(guard.rebuilds, 1);
         assert_eq!(crossings, vec![vec![], vec![], vec![0, 1]]);
+    }
+
+    /// Triangles sharing a vertex meet beyond it only when one runs through the other; sharing an
+    /// edge, only when folded flat onto each other; sharing nothing, when they intersect.
+    #[test]
+    fn triangles_meet_beyond_what_they_share() {
+        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
+        let t = [p(0.0, 0.0, 0.0), p(1.0, 0.0, 0.0), p(0.0, 1.0, 0.0)];
+        // Sharing vertex 0: lifted apart, then dipping through t.
+        let apart = [p(0.0, 0.0, 0.0), p(-1.0, 0.0, 0.5), p(0.0, -1.0, 0.5)];
+        let through = [p(0.0, 0.0, 0.0), p(0.5, 0.2, -0.5), p(0.2, 0.5, 0.5)];
+        assert!(!triangles_meet([0, 1, 2], t, [0, 3, 4], apart));
+        assert!(triangles_meet([0, 1, 2], t, [0, 3, 4], through));
+        // Sharing the edge (1, 2): across it, then folded onto t.
+        let across = [p(1.0, 0.0, 0.0), p(1.0, 1.0, 0.0), p(0.0, 1.0, 0.0)];
+        let folded = [p(1.0, 0.0, 0.0), p(0.2, 0.2, 0.0), p(0.0, 1.0, 0.0)];
+        assert!(!triangles_meet([0, 1, 2], t, [1, 5, 2], across));
+        assert!(triangles_meet([0, 1, 2], t, [1, 5, 2], folded));
+        // Nothing shared: a triangle piercing t.
+        let pierce = [p(0.2, 0.2, -1.0), p(0.3, 0.2, 1.0), p(0.2, 0.3, 1.0)];
+        assert!(triangles_meet([0, 1, 2], t, [6, 7, 8], pierce));
     }
 }
