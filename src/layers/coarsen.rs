@@ -5,9 +5,11 @@
 //! ([`super::split`]): where the field coarsens (out of a refinement region) or the front
 //! compresses (concave walls), the front's edges stay near the wanted size.
 //!
-//! Collapses are tried shortest edge first, one per column per layer. Each must pass the link
-//! condition ([`super::collapse::Merges::can_collapse`]) and leave every cell around it valid
-//! (exact predicates); one that does not is undone. Fan edges (copies of one wall vertex) never
+//! Collapses are tried shortest edge first, in rounds of at most one per column, until a round
+//! makes none (or [`MAX_ROUNDS`]): a front leaving a refinement region coarsens by up to a factor
+//! of 2^rounds a layer. Each must pass the link condition
+//! ([`super::collapse::Merges::can_collapse`]) and leave every cell around it valid (exact
+//! predicates); one that does not is undone. Fan edges (copies of one wall vertex) never
 //! collapse: they open with the distance and are what makes the fan.
 
 use std::f64::consts::FRAC_1_SQRT_2;
@@ -20,6 +22,9 @@ use super::split::Sizes;
 /// A front edge shorter than this against the collapse sizes is collapsed.
 pub const COLLAPSE_LENGTH: f64 = FRAC_1_SQRT_2;
 
+/// Rounds of collapses in one slab.
+pub const MAX_ROUNDS: usize = 3;
+
 /// Collapse the plan's short front edges; `cells_valid(plan, group)` tells whether every cell
 /// around the columns `group` is valid under the plan. Returns how many edges collapsed.
 pub(super) fn collapse_short_edges(
@@ -31,30 +36,40 @@ pub(super) fn collapse_short_edges(
 ) -> usize {
     let moving: Vec<bool> = (0..columns.len()).map(|c| plan.moving[c]).collect();
     let h = sizes.tangential(&plan.proposed[..columns.len()], &moving);
-    let mut short = short_edges(plan, front, columns, &h);
-    short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
-    let mut touched = vec![false; columns.len()];
     let mut made = 0;
-    for (_, a, b) in short {
-        if touched[a as usize] || touched[b as usize] || !plan.merges.can_collapse(front, a, b) {
-            continue;
+    for _ in 0..MAX_ROUNDS {
+        let mut short = short_edges(plan, front, columns, &h);
+        short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        let mut touched = vec![false; columns.len()];
+        let before = made;
+        for (_, a, b) in short {
+            if touched[a as usize] || touched[b as usize] || !plan.merges.can_collapse(front, a, b) {
+                continue;
+            }
+            if try_collapse(plan, columns, a, b, &cells_valid) {
+                touched[a as usize] = true;
+                touched[b as usize] = true;
+                made += 1;
+            }
         }
-        if try_collapse(plan, columns, a, b, &cells_valid) {
-            touched[a as usize] = true;
-            touched[b as usize] = true;
-            made += 1;
+        if made == before {
+            break;
         }
     }
     made
 }
 
-/// The front edges `(length, a, b)` between two moving columns that are shorter than
-/// [`COLLAPSE_LENGTH`] against the target sizes `h`, each once; fan edges and edges between columns that slide
-/// differently are left out.
+/// The front edges `(length, a, b)` between two moving roots (after the merges so far) that are
+/// shorter than [`COLLAPSE_LENGTH`] against the target sizes `h`, each once; fan edges and edges
+/// between columns that slide differently are left out.
 fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, h: &[f64]) -> Vec<(f64, u32, u32)> {
-    front
-        .edges()
-        .filter(|&(a, b)| a < b)
+    let root = |c: usize| plan.merges.root(c as u32) as usize;
+    let mut edges: Vec<(usize, usize)> =
+        front.edges().map(|(a, b)| (root(a), root(b))).filter(|&(a, b)| a < b).collect();
+    edges.sort_unstable();
+    edges.dedup();
+    edges
+        .into_iter()
         .filter(|&(a, b)| plan.moving[a] && plan.moving[b])
         .filter(|&(a, b)| !columns.is_fan_edge(a, b) && columns.slide[a] == columns.slide[b])
         .filter_map(|(a, b)| {
@@ -65,7 +80,7 @@ fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, h: &[f64]) -> 
 }
 
 /// Merge roots `a` and `b`; undo the merge (and keep the plan as it was) if a cell around them
-/// turns invalid. Neither may have merged with anything yet in this slab.
+/// turns invalid.
 fn try_collapse(
     plan: &mut SlabPlan,
     columns: &Columns,
@@ -74,13 +89,14 @@ fn try_collapse(
     cells_valid: &impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> bool {
     let saved = (plan.proposed[a as usize], plan.proposed[b as usize], plan.redirected.len());
+    let merges_before = plan.merges.clone_groups(a, b);
     entropy::collapse(plan, columns, a, b);
     let keep = plan.merges.root(a);
     let group: Vec<u32> = plan.merges.group(keep).collect();
     if cells_valid(plan, &group) {
         return true;
     }
-    plan.merges.release(keep);
+    plan.merges.restore_groups(merges_before);
     plan.proposed[a as usize] = saved.0;
     plan.proposed[b as usize] = saved.1;
     plan.redirected.truncate(saved.2);

@@ -53,6 +53,22 @@ impl Merges {
         group.extend(moved);
     }
 
+    /// The groups of roots `a` and `b` as they are, for [`Merges::restore_groups`].
+    pub fn clone_groups(&self, a: u32, b: u32) -> [(u32, Vec<u32>); 2] {
+        [a, b].map(|r| (r, self.members[r as usize].clone()))
+    }
+
+    /// Put the groups saved by [`Merges::clone_groups`] back (undoing a merge between them).
+    pub fn restore_groups(&mut self, groups: [(u32, Vec<u32>); 2]) {
+        for (r, members) in groups {
+            self.root[r as usize] = r;
+            for &m in &members {
+                self.root[m as usize] = r;
+            }
+            self.members[r as usize] = members;
+        }
+    }
+
     /// Undo every merge into `survivor`; returns the columns released (each its own root again).
     pub fn release(&mut self, survivor: u32) -> Vec<u32> {
         let released = std::mem::take(&mut self.members[survivor as usize]);
@@ -168,5 +184,19 @@ mod tests {
         }
         assert_eq!(m.release(0), vec![2, 4]);
         assert!(!m.is_merged(2));
+    }
+
+    #[test]
+    fn a_merge_between_groups_is_undone_exactly() {
+        let mut m = Merges::new(6);
+        m.merge(0, 2);
+        m.merge(1, 3);
+        let saved = m.clone_groups(0, 1);
+        m.merge(0, 1);
+        assert_eq!((m.root(1), m.root(3)), (0, 0));
+        m.restore_groups(saved);
+        assert_eq!((m.root(1), m.root(2), m.root(3)), (1, 0, 1));
+        assert_eq!(m.group(0).collect::<Vec<_>>(), vec![0, 2]);
+        assert_eq!(m.group(1).collect::<Vec<_>>(), vec![1, 3]);
     }
 }
