@@ -14,9 +14,9 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{Columns, Front};
-use super::march::SlabPlan;
+use super::march::{Reshape, SlabPlan};
 use super::slab::Polygon;
-use super::split::{self, Splits, NONE};
+use super::split::{self, NONE};
 use crate::geometry::grid::overlapping_pairs_where;
 use crate::geometry::intersect::{folds_over_shared_edge, meet_beyond_shared_vertex, triangles_intersect};
 use crate::geometry::Aabb;
@@ -63,12 +63,13 @@ impl CrossingGuard {
     pub fn rebuild(
         &mut self,
         plan: &SlabPlan,
-        splits: &Splits,
+        reshape: &Reshape,
         mesh: &VolumeMesh,
         columns: &Columns,
         front: &Front,
         reach: Reach,
     ) {
+        let splits = &reshape.splits;
         let bottom = |c: u32| mesh.points[columns.node[c as usize] as usize];
         let swept: Vec<(Aabb, bool)> = (0..front.len())
             .into_par_iter()
@@ -84,6 +85,13 @@ impl CrossingGuard {
                 }
                 for s in splits.active_on_face(f, plan).into_iter().flatten().filter(|&s| s != NONE) {
                     b.grow(splits.top[s as usize]);
+                }
+                // A swapped pair's two new triangles span both faces.
+                for tri in reshape.swaps.swapped_face(f, plan).into_iter().flatten() {
+                    for c in tri {
+                        b.grow(bottom(c));
+                        b.grow(reach.end[c as usize]);
+                    }
                 }
                 if cols.len() == 4 {
                     // The pyramid cap's apex lies within half an edge of the quad's centre.
@@ -113,7 +121,7 @@ impl CrossingGuard {
     pub fn crossing_faces(
         &self,
         plan: &SlabPlan,
-        splits: &Splits,
+        reshape: &Reshape,
         mesh: &VolumeMesh,
         columns: &Columns,
         front: &Front,
@@ -123,14 +131,14 @@ impl CrossingGuard {
         for &f in suspects {
             suspect[f] = true;
         }
-        let top = TopFront { plan, splits, mesh, columns, front };
+        let top = TopFront { plan, reshape, mesh, columns, front };
         // Most cached pairs are apart now: their current boxes sort them out cheaply.
         let boxes: Vec<Aabb> = (0..front.len()).into_par_iter().map(|f| top.cap_box(f)).collect();
         let tested: Vec<(u32, u32)> = self
             .pairs
             .par_iter()
             .copied()
-            .chain(pairs_at_changes(plan, splits, front, suspects).into_par_iter())
+            .chain(pairs_at_changes(plan, reshape, front, suspects).into_par_iter())
             .filter(|&(f, g)| {
                 (suspect[f as usize] || suspect[g as usize]) && boxes[f as usize].overlaps(&boxes[g as usize])
             })
@@ -163,13 +171,21 @@ impl CrossingGuard {
 /// the `suspects`. A front moving as a whole cannot fold over a shared vertex without turning a
 /// cell between them inside out; where columns stop at different layers or merge, thin
 /// triangles can, with every cell valid, so these pairs are tested beyond their shared vertex.
-fn pairs_at_changes(plan: &SlabPlan, splits: &Splits, front: &Front, suspects: &[usize]) -> Vec<(u32, u32)> {
+fn pairs_at_changes(
+    plan: &SlabPlan,
+    reshape: &Reshape,
+    front: &Front,
+    suspects: &[usize],
+) -> Vec<(u32, u32)> {
     let changes = |f: usize| {
         let cols = front.face_columns(f);
         let moving = |c: u32| plan.moving[plan.merges.root(c) as usize];
         let mixed = cols.iter().any(|&c| moving(c)) && cols.iter().any(|&c| !moving(c));
         let merged = cols.iter().any(|&c| plan.merges.is_merged(c) || plan.merges.group(c).nth(1).is_some());
-        mixed || merged || splits.active_on_face(f, plan).is_some()
+        mixed
+            || merged
+            || reshape.splits.active_on_face(f, plan).is_some()
+            || reshape.swaps.role(f, plan).is_some()
     };
     let mut pairs: Vec<(u32, u32)> = suspects
         .par_iter()
@@ -194,7 +210,7 @@ fn pairs_at_changes(plan: &SlabPlan, splits: &Splits, front: &Front, suspects: &
 /// The proposed top of the front faces under a slab plan.
 struct TopFront<'a> {
     plan: &'a SlabPlan,
-    splits: &'a Splits,
+    reshape: &'a Reshape,
     mesh: &'a VolumeMesh,
     columns: &'a Columns,
     front: &'a Front,
@@ -229,12 +245,22 @@ impl TopFront<'_> {
     fn top(&self, f: usize) -> (Vec<(u32, DVec3)>, Option<[u32; 4]>) {
         let mut top: Vec<(u32, DVec3)> =
             self.front.face_columns(f).iter().map(|&c| self.node_and_position(c)).collect();
-        let on_edge = self.splits.active_on_face(f, self.plan);
+        if let Some(swapped) = self.reshape.swaps.swapped_face(f, self.plan) {
+            let d = swapped[0][2];
+            if !self.front.face_columns(f).contains(&d) {
+                top.push(self.node_and_position(d));
+            } else {
+                top.push(self.node_and_position(swapped[0][0]));
+            }
+            return (top, None);
+        }
+        let splits = &self.reshape.splits;
+        let on_edge = splits.active_on_face(f, self.plan);
         let first = self.mesh.points.len() as u32 + self.columns.len() as u32;
         let mids = on_edge.map(|e| e.map(|s| if s == NONE { NONE } else { first + s }));
         for (s, id) in on_edge.into_iter().flatten().zip(mids.into_iter().flatten()) {
             if s != NONE {
-                top.push((id, self.splits.top[s as usize]));
+                top.push((id, splits.top[s as usize]));
             }
         }
         (top, mids)
@@ -261,9 +287,12 @@ impl TopFront<'_> {
         let n = self.front.face_columns(f).len();
         let ids: Vec<u32> = top[..n].iter().map(|t| t.0).collect();
         let at = |id: u32| top.iter().find(|t| t.0 == id).map_or(DVec3::ZERO, |t| t.1);
-        let parts = match mids {
-            Some(mids) => split::subdivide(&ids, &mids[..n]),
-            None => vec![ids],
+        let node = |c: u32| self.node_and_position(c).0;
+        let parts = match (mids, self.reshape.swaps.swapped_face(f, self.plan)) {
+            // Both faces of a swapped pair carry its two new triangles.
+            (_, Some(swapped)) => swapped.iter().map(|tri| tri.map(node).to_vec()).collect(),
+            (Some(mids), None) => split::subdivide(&ids, &mids[..n]),
+            (None, None) => vec![ids],
         };
         for (i, part) in parts.iter().enumerate() {
             let Some(polygon) = Polygon::dedup(part) else { continue };
@@ -401,14 +430,21 @@ mod tests {
                     .collect();
                 guard.rebuild(
                     &plan,
-                    &Splits::default(),
+                    &Reshape::default(),
                     &mesh,
                     &columns,
                     &front,
                     Reach { end, through_layer: k + LOOKAHEAD_LAYERS - 1 },
                 );
             }
-            crossings.push(guard.crossing_faces(&plan, &Splits::default(), &mesh, &columns, &front, &[0, 1]));
+            crossings.push(guard.crossing_faces(
+                &plan,
+                &Reshape::default(),
+                &mesh,
+                &columns,
+                &front,
+                &[0, 1],
+            ));
             for (c, p) in proposed.into_iter().enumerate() {
                 columns.node[c] = mesh.points.len() as u32;
                 mesh.points.push(p);

@@ -17,6 +17,7 @@ use super::front::{Columns, Front};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
 use super::split::{self, Adapt, Sizes, Splits, NONE};
+use super::swap::{self, SwapRole, Swaps};
 use super::{coarsen, entropy};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -45,6 +46,8 @@ pub struct MarchStats {
     /// Long front edges left unsplit for a layer because the split would have made an invalid
     /// cell.
     pub splits_given_up: usize,
+    /// Front edges swapped (a pair of badly shaped triangles turned over their shared edge).
+    pub swaps: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -156,18 +159,6 @@ impl SlabPlan {
     }
 }
 
-/// Bottom and top node ids of a front face under a slab plan, its size, and how its columns
-/// merged.
-fn face_nodes(
-    front: &Front,
-    f: usize,
-    plan: &SlabPlan,
-    columns: &Columns,
-    committed: u32,
-) -> ([u32; 4], [u32; 4], usize, Merging) {
-    face_ends(front, f, columns, &plan.merges, |c| plan.top(c, columns, committed))
-}
-
 /// Bottom node, top node (`top(c)`) and merging of every column of face `f`, and its size.
 fn face_ends(
     front: &Front,
@@ -222,22 +213,63 @@ fn cut_from(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32) -
     }
 }
 
-/// The cell over front face `f` under a slab plan, with its active splits; the new column of
-/// split `s` proposes the node `committed + columns.len() + s`.
+/// The changes of the front's topology proposed for one slab (tangential adaptivity): splits
+/// of long edges and swaps of badly shaped pairs (the collapses are merges of the plan).
+#[derive(Debug, Default)]
+pub(super) struct Reshape {
+    pub splits: Splits,
+    pub swaps: Swaps,
+}
+
+impl Reshape {
+    /// Give up the swap, else the splits, of invalid face `f`; returns the faces whose cells
+    /// change (none if it had neither).
+    fn give_up(&mut self, f: usize, plan: &SlabPlan) -> Vec<usize> {
+        let swapped = self.swaps.give_up(f, plan);
+        if !swapped.is_empty() {
+            return swapped;
+        }
+        self.splits.give_up(f, plan)
+    }
+}
+
+/// The cell over front face `f` under a slab plan, with its active splits and swap; the new
+/// column of split `s` proposes the node `committed + columns.len() + s`.
 fn face_cell(
     front: &Front,
     f: usize,
     plan: &SlabPlan,
-    splits: &Splits,
+    reshape: &Reshape,
     columns: &Columns,
     committed: u32,
 ) -> SlabCell {
-    let (b, t, n, merging) = face_nodes(front, f, plan, columns, committed);
-    match splits.active_on_face(f, plan) {
+    let first = committed + columns.len() as u32;
+    cell_of_face(front, f, plan, reshape, columns, |c| plan.top(c, columns, committed), |s| first + s)
+}
+
+/// The cell over front face `f`, with the top node `top(c)` of every column and the top node
+/// `mid(s)` of every active split `s`.
+fn cell_of_face(
+    front: &Front,
+    f: usize,
+    plan: &SlabPlan,
+    reshape: &Reshape,
+    columns: &Columns,
+    top: impl Fn(u32) -> u32,
+    mid: impl Fn(u32) -> u32,
+) -> SlabCell {
+    match reshape.swaps.role(f, plan) {
+        Some(SwapRole::Absorbed) => return SlabCell::Empty,
+        Some(SwapRole::Cell(four)) => {
+            return swap::swap_cell(four.map(|c| columns.node[c as usize]), four.map(&top));
+        }
+        None => {}
+    }
+    let (b, t, n, merging) = face_ends(front, f, columns, &plan.merges, top);
+    match reshape.splits.active_on_face(f, plan) {
         None => slab_cell(&b[..n], &t[..n], merging),
         Some(on_edge) => {
-            let first = committed + columns.len() as u32;
-            let mids = on_edge.map(|s| if s == NONE { NONE } else { first + s });
+            let mids = on_edge.map(|s| if s == NONE { NONE } else { mid(s) });
             split::split_cell(&b[..n], &t[..n], &mids[..n], merging)
         }
     }
@@ -284,20 +316,26 @@ pub fn march(
                 _ => DVec3::ZERO,
             })
             .collect();
-        let mut splits = match sizes.adapt {
-            Adapt::Off => Splits::default(),
-            Adapt::Wall | Adapt::Field(_) => split::propose(columns, front, &proposed, k, sizes),
+        let mut reshape = match sizes.adapt {
+            Adapt::Off => Reshape::default(),
+            Adapt::Wall | Adapt::Field(_) => {
+                let splits = split::propose(columns, front, &proposed, k, sizes);
+                let swaps = swap::propose(columns, front, &proposed, &splits);
+                Reshape { splits, swaps }
+            }
         };
-        proposed.extend_from_slice(&splits.top);
-        let plan = settle_slab(mesh, columns, front, proposed, &mut splits, sizes, &mut guard, k);
+        proposed.extend_from_slice(&reshape.splits.top);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut reshape, sizes, &mut guard, k);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses - plan.coarsened;
         stats.tangential_collapses += plan.coarsened;
-        let split_count = commit_slab(mesh, columns, front, &plan, &splits, sizes, k, &mut stats);
+        let (split_count, swap_count) =
+            commit_slab(mesh, columns, front, &plan, &reshape, sizes, k, &mut stats);
         stats.splits += split_count;
-        stats.splits_given_up += splits.len() - split_count;
-        if plan.collapses > 0 || !plan.redirected.is_empty() || split_count > 0 {
+        stats.splits_given_up += reshape.splits.len() - split_count;
+        stats.swaps += swap_count;
+        if plan.collapses > 0 || !plan.redirected.is_empty() || split_count > 0 || swap_count > 0 {
             guard.invalidate();
         }
         stats.layers_marched = k;
@@ -450,7 +488,7 @@ fn settle_slab(
     columns: &Columns,
     front: &Front,
     proposed: Vec<DVec3>,
-    splits: &mut Splits,
+    reshape: &mut Reshape,
     sizes: &Sizes,
     guard: &mut CrossingGuard,
     k: u32,
@@ -465,13 +503,13 @@ fn settle_slab(
     };
     if !matches!(sizes.adapt, Adapt::Off) {
         let committed = mesh.points.len() as u32;
-        let splits = &*splits;
+        let reshape = &*reshape;
         plan.coarsened = coarsen::collapse_short_edges(&mut plan, front, columns, sizes, |plan, group| {
             let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
             front
                 .faces_around_columns(group)
                 .into_iter()
-                .all(|f| proposal.cell_is_valid(&face_cell(front, f, plan, splits, columns, committed)))
+                .all(|f| proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
         });
     }
     let mut to_check: Vec<usize> = (0..front.len()).collect();
@@ -480,11 +518,11 @@ fn settle_slab(
         .filter(|&f| front.face_columns(f).iter().any(|&c| plan.moving[c as usize]))
         .collect();
     loop {
-        repair_invalid_cells(&mut plan, splits, mesh, columns, front, to_check);
+        repair_invalid_cells(&mut plan, reshape, mesh, columns, front, to_check);
         if guard.is_stale(k, &plan) {
-            guard.rebuild(&plan, splits, mesh, columns, front, reach(&plan, mesh, columns, k));
+            guard.rebuild(&plan, reshape, mesh, columns, front, reach(&plan, mesh, columns, k));
         }
-        let crossing = guard.crossing_faces(&plan, splits, mesh, columns, front, &suspects);
+        let crossing = guard.crossing_faces(&plan, reshape, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
         for f in crossing {
             tracing::debug!(face = f, at = ?wall_points(front, f, columns), "the new front crosses itself: stopping the face's columns");
@@ -503,13 +541,14 @@ fn settle_slab(
 }
 
 /// Check the cells over `to_check` and repair the invalid ones until every cell is valid: giving
-/// up their splits, else a collapse where a cell is being crushed, else stopping its columns.
+/// up their swap or splits, else a collapse where a cell is being crushed, else stopping its
+/// columns.
 /// Collapses come first: an invalid cell without a crushed edge of its own may be mended by a
 /// collapse next to it (its neighbour crosses the bisector in another cell), so its columns stop
 /// only after a round that collapsed nothing.
 fn repair_invalid_cells(
     plan: &mut SlabPlan,
-    splits: &mut Splits,
+    reshape: &mut Reshape,
     mesh: &VolumeMesh,
     columns: &Columns,
     front: &Front,
@@ -519,18 +558,18 @@ fn repair_invalid_cells(
     while !to_check.is_empty() {
         let invalid: Vec<usize> = {
             let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-            let (plan, splits) = (&*plan, &*splits);
+            let (plan, reshape) = (&*plan, &*reshape);
             to_check
                 .par_iter()
                 .copied()
-                .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, splits, columns, committed)))
+                .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
                 .collect()
         };
         let mut changed = Vec::new();
         let mut changed_faces = Vec::new();
         let mut uncollapsed = Vec::new();
         for &f in &invalid {
-            let given_up = splits.give_up(f, plan);
+            let given_up = reshape.give_up(f, plan);
             if !given_up.is_empty() {
                 changed_faces.extend(given_up);
                 continue;
@@ -567,19 +606,21 @@ fn wall_points(front: &Front, f: usize, columns: &Columns) -> Vec<(u32, [f32; 3]
     front.face_columns(f).iter().map(|&c| at(c)).collect()
 }
 
-/// Create the nodes of the moving columns and of the splits, emit the slab's cells, add the
-/// split columns and apply the merges; returns the number of splits made.
+/// Create the nodes of the moving columns and of the splits, emit the slab's cells, swap the
+/// swapped faces, add the split columns and apply the merges; returns the number of splits and
+/// of swaps made.
 #[allow(clippy::too_many_arguments)]
 fn commit_slab(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
     front: &mut Front,
     plan: &SlabPlan,
-    splits: &Splits,
+    reshape: &Reshape,
     sizes: &mut Sizes,
     k: u32,
     stats: &mut MarchStats,
-) -> usize {
+) -> (usize, usize) {
+    let splits = &reshape.splits;
     let mut new_node = vec![u32::MAX; columns.len()];
     for c in 0..columns.len() {
         if plan.moving[c] && !plan.merges.is_merged(c as u32) {
@@ -606,15 +647,10 @@ fn commit_slab(
     let cells: Vec<(bool, SlabCell)> = (0..front.len())
         .into_par_iter()
         .map(|f| {
-            let (b, t, n, merging) = face_ends(front, f, columns, &plan.merges, |c| top[c as usize]);
-            let cell = match splits.active_on_face(f, plan) {
-                None => slab_cell(&b[..n], &t[..n], merging),
-                Some(on_edge) => {
-                    let mids = on_edge.map(|s| if s == NONE { NONE } else { mid_node[s as usize] });
-                    split::split_cell(&b[..n], &t[..n], &mids[..n], merging)
-                }
-            };
-            (b[..n] != t[..n], cell)
+            let moved = front.face_columns(f).iter().any(|&c| top[c as usize] != columns.node[c as usize]);
+            let cell =
+                cell_of_face(front, f, plan, reshape, columns, |c| top[c as usize], |s| mid_node[s as usize]);
+            (moved, cell)
         })
         .collect();
     for (f, (moved, cell)) in cells.into_iter().enumerate() {
@@ -646,16 +682,17 @@ fn commit_slab(
         columns.dir[c as usize] = dir;
         columns.scale[c as usize] = scale;
     }
+    let swapped = swap::commit(&reshape.swaps, plan, front);
     let old_count = columns.len() as u32;
     let made = split::commit(splits, plan, &mid_node, k, columns, front, sizes);
     if plan.collapses > 0 {
         let mut carrier = plan.merges.roots().to_vec();
         carrier.extend(old_count..columns.len() as u32);
         front.apply_merges(&carrier);
-    } else if made > 0 {
+    } else if made > 0 || swapped > 0 {
         front.index_columns(columns.len());
     }
-    made
+    (made, swapped)
 }
 
 /// Remember column `c`'s new step and how it compares with the one before.

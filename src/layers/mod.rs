@@ -14,6 +14,7 @@ pub mod slab;
 pub mod sliding;
 pub mod smoothness;
 pub mod split;
+pub mod swap;
 
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;

@@ -215,6 +215,15 @@ impl Splits {
         changed
     }
 
+    /// Whether each of the front's `face_count` faces has a split proposed on an edge.
+    pub(super) fn faces_with_splits(&self, face_count: usize) -> Vec<bool> {
+        let mut has = vec![false; face_count];
+        for &(f, _) in &self.faces {
+            has[f as usize] = true;
+        }
+        has
+    }
+
     /// The splits made under `plan`.
     pub(super) fn active(&self, plan: &SlabPlan) -> Vec<usize> {
         (0..self.len()).filter(|&s| self.is_active(s, plan)).collect()

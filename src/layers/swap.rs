@@ -1,0 +1,258 @@
+//! Edge swaps on the front (issue 4, DESIGN.md "Tangential adaptivity"): where two front
+//! triangles `(a, b, c)` and `(b, a, d)` would top out badly shaped (splits fan long edges from
+//! their middle; columns converge), their shared edge is swapped for `(c, d)`: the new front has
+//! the triangles `(c, a, d)` and `(d, b, c)`.
+//!
+//! In the slab being built, the two cells over the pair become one polyhedron: the two bottom
+//! triangles with the old diagonal, the two top triangles with the new one, and the four lateral
+//! faces over the pair's outer edges, as its neighbours build them (so the slab stays
+//! conforming). It is split from its centre ([`super::slab::cell_from_faces`]). A swap whose
+//! cell would be invalid is given up for the layer; a swap whose columns do not all move on
+//! their own (one stopped or merged) is not made.
+
+use glam::DVec3;
+
+use super::front::{Columns, Front};
+use super::march::SlabPlan;
+use super::slab::{self, cell_from_faces, Polygon, SlabCell};
+use super::split::Splits;
+
+/// A pair is swapped only when its worst angle is below this (degrees)...
+const POOR_ANGLE: f64 = 30.0;
+/// ...and the swap raises it by at least this factor.
+const GAIN: f64 = 1.25;
+
+/// One swap: faces `f = (a, b, c)` and `g = (b, a, d)` become `(c, a, d)` and `(d, b, c)`.
+#[derive(Clone, Copy, Debug)]
+struct Swap {
+    faces: [u32; 2],
+    /// `[a, b, c, d]`: the shared edge, then `f`'s and `g`'s opposite columns.
+    columns: [u32; 4],
+    enabled: bool,
+}
+
+/// The swaps proposed for one slab.
+#[derive(Debug, Default)]
+pub(super) struct Swaps {
+    swaps: Vec<Swap>,
+    /// The swap on each face (`u32::MAX`: none); empty when there are no swaps.
+    on_face: Vec<u32>,
+}
+
+/// How a face takes part in an active swap.
+pub(super) enum SwapRole {
+    /// The first face of the pair: its cell is the pair's polyhedron (bottom and top nodes of
+    /// `[a, b, c, d]`).
+    Cell([u32; 4]),
+    /// The second face: its cell is the first's.
+    Absorbed,
+}
+
+impl Swaps {
+    pub fn len(&self) -> usize {
+        self.swaps.len()
+    }
+
+    fn is_active(&self, s: usize, plan: &SlabPlan) -> bool {
+        let swap = &self.swaps[s];
+        swap.enabled && swap.columns.iter().all(|&c| plan.moving[c as usize] && !plan.merges.is_merged(c))
+    }
+
+    fn active_index(&self, f: usize, plan: &SlabPlan) -> Option<usize> {
+        let s = *self.on_face.get(f)?;
+        (s != u32::MAX && self.is_active(s as usize, plan)).then_some(s as usize)
+    }
+
+    /// Face `f`'s part in its active swap, if it has one.
+    pub fn role(&self, f: usize, plan: &SlabPlan) -> Option<SwapRole> {
+        let s = self.active_index(f, plan)?;
+        let swap = &self.swaps[s];
+        Some(if swap.faces[0] as usize == f { SwapRole::Cell(swap.columns) } else { SwapRole::Absorbed })
+    }
+
+    /// The columns of face `f`'s top after its active swap, if it has one.
+    pub fn swapped_face(&self, f: usize, plan: &SlabPlan) -> Option<[[u32; 3]; 2]> {
+        let s = self.active_index(f, plan)?;
+        let [a, b, c, d] = self.swaps[s].columns;
+        Some([[c, a, d], [d, b, c]])
+    }
+
+    /// Give up face `f`'s active swap; returns the two faces whose cells change.
+    pub fn give_up(&mut self, f: usize, plan: &SlabPlan) -> Vec<usize> {
+        let Some(s) = self.active_index(f, plan) else { return Vec::new() };
+        self.swaps[s].enabled = false;
+        self.swaps[s].faces.map(|g| g as usize).to_vec()
+    }
+
+    /// The swaps made under `plan`.
+    pub fn active<'a>(&'a self, plan: &'a SlabPlan) -> impl Iterator<Item = usize> + 'a {
+        (0..self.len()).filter(move |&s| self.is_active(s, plan))
+    }
+}
+
+/// Propose swaps on the front with the tops at `proposed`: pairs of triangles of one patch whose
+/// four columns are alive and slide alike, one of them born by a split (the wall's own triangles
+/// are never swapped: their first cells stay prisms on the wall), with no split on their edges,
+/// whose worst top angle is poor and would gain by the swap without folding; each column in one
+/// swap at most, the worst pairs first.
+pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], splits: &Splits) -> Swaps {
+    let mut candidates: Vec<(f64, Swap)> = Vec::new();
+    let split_faces = splits.faces_with_splits(front.len());
+    for f in 0..front.len() {
+        let cols = front.face_columns(f);
+        if cols.len() != 3 || split_faces[f] {
+            continue;
+        }
+        for i in 0..3 {
+            let (a, b, c) = (cols[i], cols[(i + 1) % 3], cols[(i + 2) % 3]);
+            let Some(g) = opposite_face(front, f, a, b) else { continue };
+            if g < f || split_faces[g] || front.patch[g] != front.patch[f] {
+                continue;
+            }
+            let other = front.face_columns(g);
+            let Some(&d) = other.iter().find(|&&x| x != a && x != b) else { continue };
+            let four = [a, b, c, d];
+            let usable =
+                |x: u32| columns.alive[x as usize] && columns.slide[x as usize] == columns.slide[a as usize];
+            if !four.iter().all(|&x| usable(x)) || c == d || front.are_neighbours(c, d) {
+                continue;
+            }
+            // The wall's own triangulation is the user's: only pairs a split made are swapped.
+            if four.iter().all(|&x| columns.born_at[x as usize] == 0) {
+                continue;
+            }
+            let at = four.map(|x| proposed[x as usize]);
+            if let Some(old) = gain(at) {
+                candidates.push((old, Swap { faces: [f as u32, g as u32], columns: four, enabled: true }));
+            }
+        }
+    }
+    candidates.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut swaps = Swaps { swaps: Vec::new(), on_face: Vec::new() };
+    if candidates.is_empty() {
+        return swaps;
+    }
+    swaps.on_face = vec![u32::MAX; front.len()];
+    let mut used_column = vec![false; columns.len()];
+    for (_, swap) in candidates {
+        let [f, g] = swap.faces.map(|x| x as usize);
+        if swaps.on_face[f] != u32::MAX || swaps.on_face[g] != u32::MAX {
+            continue;
+        }
+        // Swaps sharing a column would cut the same lateral faces two ways.
+        if swap.columns.iter().any(|&c| used_column[c as usize]) {
+            continue;
+        }
+        for &c in &swap.columns {
+            used_column[c as usize] = true;
+        }
+        let s = swaps.swaps.len() as u32;
+        swaps.on_face[f] = s;
+        swaps.on_face[g] = s;
+        swaps.swaps.push(swap);
+    }
+    swaps
+}
+
+/// The other face on the front edge `(a, b)` of face `f` (a triangle), if it is a triangle
+/// holding `(b, a)`.
+fn opposite_face(front: &Front, f: usize, a: u32, b: u32) -> Option<usize> {
+    front.faces_of(a).filter(|&g| g != f).find(|&g| {
+        let cols = front.face_columns(g);
+        cols.len() == 3 && (0..3).any(|i| cols[i] == b && cols[(i + 1) % 3] == a)
+    })
+}
+
+/// For tops `[a, b, c, d]` of the pair `(a, b, c)`, `(b, a, d)`: the pair's worst angle when
+/// swapping to `(c, a, d)`, `(d, b, c)` is worth it (the worst is poor, rises by [`GAIN`], and
+/// the new triangles face the old pair's way), else `None`.
+fn gain([a, b, c, d]: [DVec3; 4]) -> Option<f64> {
+    let old = min_angle(a, b, c).min(min_angle(b, a, d));
+    if old >= POOR_ANGLE {
+        return None;
+    }
+    let new = min_angle(c, a, d).min(min_angle(d, b, c));
+    let normal = (b - a).cross(c - a) + (a - b).cross(d - b);
+    let (n1, n2) = ((a - c).cross(d - c), (b - d).cross(c - d));
+    let facing = n1.dot(normal) > 0.0 && n2.dot(normal) > 0.0 && n1.dot(n2) > 0.5 * n1.length() * n2.length();
+    (facing && new > GAIN * old).then_some(old)
+}
+
+/// The smallest angle of triangle `(a, b, c)`, in degrees.
+fn min_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let angle = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p).to_degrees();
+    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
+}
+
+/// The cell over a swapped pair with bottom nodes `bottom` and top nodes `top` of `[a, b, c, d]`
+/// (see the module docs); the lateral faces over the outer edges as [`slab::push_lateral`] makes
+/// them for the neighbours (no column of a swap merges, so none is cut).
+pub(super) fn swap_cell(bottom: [u32; 4], top: [u32; 4]) -> SlabCell {
+    let [a, b, c, d] = [0, 1, 2, 3];
+    let mut faces = Vec::with_capacity(8);
+    for tri in [[a, b, c], [b, a, d]] {
+        let reversed = [bottom[tri[2]], bottom[tri[1]], bottom[tri[0]]];
+        faces.extend(Polygon::dedup(&reversed));
+    }
+    for tri in [[c, a, d], [d, b, c]] {
+        faces.extend(Polygon::dedup(&tri.map(|i| top[i])));
+    }
+    for (i, j) in [(b, c), (c, a), (a, d), (d, b)] {
+        slab::push_lateral(&mut faces, [bottom[i], bottom[j], top[j], top[i]], None);
+    }
+    slab::remove_opposite_pairs(&mut faces);
+    cell_from_faces(faces)
+}
+
+/// Swap the front faces of the swaps made under `plan`; the front's adjacency must be rebuilt
+/// after. Returns how many were made.
+pub(super) fn commit(swaps: &Swaps, plan: &SlabPlan, front: &mut Front) -> usize {
+    let active: Vec<usize> = swaps.active(plan).collect();
+    for &s in &active {
+        let swap = &swaps.swaps[s];
+        let [a, b, c, d] = swap.columns;
+        let [f, g] = swap.faces.map(|x| x as usize);
+        front.subdivide_face(f, &[vec![c, a, d]]);
+        front.subdivide_face(g, &[vec![d, b, c]]);
+    }
+    active.len()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn a_thin_pair_gains_by_the_swap_and_a_good_one_does_not() {
+        let p = |x: f64, y: f64| DVec3::new(x, y, 0.0);
+        // A long diagonal (a, b) between two flat triangles: the swap to (c, d) is better.
+        assert!(gain([p(0.0, 0.0), p(4.0, 0.0), p(2.0, 0.5), p(2.0, -0.5)]).is_some());
+        // Two equilateral triangles: nothing to gain.
+        let h = 3f64.sqrt() / 2.0;
+        assert!(gain([p(0.0, 0.0), p(1.0, 0.0), p(0.5, h), p(0.5, -h)]).is_none());
+        // A non-convex pair: the swap would fold.
+        assert!(gain([p(0.0, 0.0), p(4.0, 0.0), p(0.5, 0.3), p(-1.0, -0.2)]).is_none());
+    }
+
+    #[test]
+    fn the_swapped_pair_is_one_cell_closed_by_its_faces() {
+        // Bottom nodes 0..4, top nodes 10..14: 2 + 2 triangles and 4 lateral quads.
+        match swap_cell([0, 1, 2, 3], [10, 11, 12, 13]) {
+            SlabCell::Split { faces, .. } => {
+                assert_eq!(faces.len(), 8);
+                let mut directed: Vec<(u32, u32)> = faces
+                    .iter()
+                    .flat_map(|p| {
+                        let n = p.nodes();
+                        (0..n.len()).map(move |i| (n[i], n[(i + 1) % n.len()]))
+                    })
+                    .collect();
+                directed.sort_unstable();
+                for &(x, y) in &directed {
+                    assert!(directed.binary_search(&(y, x)).is_ok(), "edge ({x}, {y}) unmatched: not closed");
+                }
+            }
+            other => panic!("{other:?}"),
+        }
+    }
+}
