@@ -25,20 +25,19 @@ pub const COLLAPSE_LENGTH: f64 = FRAC_1_SQRT_2;
 /// Rounds of collapses in one slab.
 pub const MAX_ROUNDS: usize = 3;
 
-/// Collapse the plan's short front edges; `cells_valid(plan, group)` tells whether every cell
-/// around the columns `group` is valid under the plan. Returns how many edges collapsed.
+/// Collapse the plan's short front edges against the tangential sizes `h` at the columns'
+/// proposed tops; `cells_valid(plan, group)` tells whether every cell around the columns
+/// `group` is valid under the plan. Returns how many edges collapsed.
 pub(super) fn collapse_short_edges(
     plan: &mut SlabPlan,
     front: &Front,
     columns: &Columns,
-    sizes: &Sizes,
+    h: &[f64],
     cells_valid: impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> usize {
-    let moving: Vec<bool> = (0..columns.len()).map(|c| plan.moving[c]).collect();
-    let h = sizes.tangential(&plan.proposed[..columns.len()], &moving);
     let mut made = 0;
     for _ in 0..MAX_ROUNDS {
-        let mut short = short_edges(plan, front, columns, &h);
+        let mut short = short_edges(plan, front, columns, h);
         short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         let mut touched = vec![false; columns.len()];
         let before = made;

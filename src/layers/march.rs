@@ -219,6 +219,9 @@ fn cut_from(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32) -
 pub(super) struct Reshape {
     pub splits: Splits,
     pub swaps: Swaps,
+    /// The tangential size at every column's proposed top (evaluated once a slab: a sizing
+    /// field's size is a search over the wall).
+    pub target: Vec<f64>,
 }
 
 impl Reshape {
@@ -319,9 +322,10 @@ pub fn march(
         let mut reshape = match sizes.adapt {
             Adapt::Off => Reshape::default(),
             Adapt::Wall | Adapt::Field(_) => {
-                let splits = split::propose(columns, front, &proposed, k, sizes);
+                let target = sizes.tangential(&proposed, &columns.alive);
+                let splits = split::propose(columns, front, &proposed, k, sizes, &target);
                 let swaps = swap::propose(columns, front, &proposed, &splits);
-                Reshape { splits, swaps }
+                Reshape { splits, swaps, target }
             }
         };
         proposed.extend_from_slice(&reshape.splits.top);
@@ -504,13 +508,14 @@ fn settle_slab(
     if !matches!(sizes.adapt, Adapt::Off) {
         let committed = mesh.points.len() as u32;
         let reshape = &*reshape;
-        plan.coarsened = coarsen::collapse_short_edges(&mut plan, front, columns, sizes, |plan, group| {
-            let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-            front
-                .faces_around_columns(group)
-                .into_iter()
-                .all(|f| proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
-        });
+        plan.coarsened =
+            coarsen::collapse_short_edges(&mut plan, front, columns, &reshape.target, |plan, group| {
+                let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+                front
+                    .faces_around_columns(group)
+                    .into_iter()
+                    .all(|f| proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
+            });
     }
     let mut to_check: Vec<usize> = (0..front.len()).collect();
     // Two faces that do not move cannot start to cross: only moving ones are suspects.
