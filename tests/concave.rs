@@ -94,3 +94,20 @@ fn notched_box_layers_merge_at_the_concave_corner() {
     let err = offset_error(&surface, &out, t);
     assert!(err < 0.02, "top front off the exact offset by {:.2}% of the thickness", 100.0 * err);
 }
+
+/// Straight concave ridges of 60, 90 and 120 degrees (issue 7's wedges: a V groove in a block):
+/// the fronts of the groove's walls meet on its bisector plane and keep marching, every wall
+/// vertex gets its full stack, and the top front lies on the exact offset.
+#[test]
+fn v_grooves_of_60_90_120_degrees_keep_every_layer() {
+    for opening in [60.0, 90.0, 120.0] {
+        let surface = shapes::grooved_block(opening, 4);
+        // 12 layers from 0.01: 0.40 thick, more than one wall edge (0.25) each side of the ridge.
+        let (out, t) = mesh(&surface, 0.01, 12);
+        let name = format!("{opening}-degree groove");
+        assert_full_coverage(&name, &out);
+        let err = offset_error(&surface, &out, t);
+        eprintln!("{name}: top front off the exact offset by at most {:.2}% of the thickness", 100.0 * err);
+        assert!(err < 0.02, "{name}: top front off the exact offset by {:.2}% of the thickness", 100.0 * err);
+    }
+}

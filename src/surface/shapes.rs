@@ -61,6 +61,29 @@ pub fn cuboid(size: DVec3, n: usize) -> Surface {
     s
 }
 
+/// A block 8 x 2 x 2 with a V groove along y, one deep, whose walls meet at `opening_deg` at
+/// its bottom (x = 4, z = 1): a straight concave ridge of that opening as seen from the fluid,
+/// between two convex lips. Built as a box grid with `n` squares per unit, moved in x so that
+/// grid lines fall on the lips and the bottom, and squeezed in z under the groove.
+pub fn grooved_block(opening_deg: f64, n: usize) -> Surface {
+    let half_width = (0.5 * opening_deg.to_radians()).tan();
+    assert!(half_width > 0.0 && half_width < 4.0, "opening {opening_deg} deg does not fit the block");
+    let mut s = voxels([8, 2, 2], 1.0, n, |_, _, _| true);
+    // Grid x 0..3 | 3..4 | 4..5 | 5..8 onto 0..4-w | 4-w..4 | 4..4+w | 4+w..8.
+    let stations = [(0.0, 0.0), (3.0, 4.0 - half_width), (4.0, 4.0), (5.0, 4.0 + half_width), (8.0, 8.0)];
+    let to_x = |x: f64| {
+        let i = stations.windows(2).position(|w| x <= w[1].0).unwrap_or(stations.len() - 2);
+        let ((x0, y0), (x1, y1)) = (stations[i], stations[i + 1]);
+        y0 + (y1 - y0) * (x - x0) / (x1 - x0)
+    };
+    for p in &mut s.points {
+        let x = to_x(p.x);
+        let top = 2.0 - (1.0 - (x - 4.0).abs() / half_width).max(0.0);
+        *p = DVec3::new(x, p.y, p.z * top / 2.0);
+    }
+    s
+}
+
 /// Shared grid points, so faces of neighbouring voxels are welded.
 struct GridBuilder {
     h: f64,
@@ -202,5 +225,16 @@ mod tests {
         let exact = 4.0 / 3.0 * std::f64::consts::PI * 8.0;
         let v = s.enclosed_volume();
         assert!(v > 0.97 * exact && v < exact, "{v} vs {exact}");
+    }
+
+    #[test]
+    fn grooved_blocks_lose_the_groove_volume() {
+        for opening in [60.0f64, 90.0, 120.0] {
+            let s = grooved_block(opening, 2);
+            let w = (0.5 * opening.to_radians()).tan();
+            // 8 x 2 x 2 less the groove's triangle (width 2w, depth 1) along y = 0..2.
+            let exact = 32.0 - 2.0 * w;
+            assert!((s.enclosed_volume() - exact).abs() < 1e-9, "{opening}: {}", s.enclosed_volume());
+        }
     }
 }
