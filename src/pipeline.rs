@@ -91,6 +91,10 @@ pub struct LayerSummary {
     /// those on convex ridges and at convex or saddle corners (1 when there are none).
     pub concave_coverage: f64,
     pub convex_coverage: f64,
+    /// The same over the vertices within two target thicknesses of a concave ridge edge, where
+    /// fronts meet (1 when there are none), and how many they are.
+    pub near_concave_coverage: f64,
+    pub near_concave_vertices: usize,
     /// Wall vertices whose column stopped before its target, with a few examples.
     pub stopped_vertices: usize,
     pub stopped_examples: Vec<[f64; 3]>,
@@ -190,7 +194,7 @@ pub fn run(
             )));
         }
     };
-    let layer_summary = layer_summary(&layered, &surface, &features);
+    let layer_summary = layer_summary(&layered, &surface, &topology, &features);
     let (mesh, core) = if options.core {
         let (mesh, mut stats) = timings.time("core", || {
             let options = CoreOptions::from_config(config);
@@ -313,27 +317,32 @@ fn not_planar_warnings(surface: &Surface, layered_patch: &[bool], planes: &[Opti
         .collect()
 }
 
-fn layer_summary(layered: &layers::Layers, surface: &Surface, features: &Features) -> LayerSummary {
+fn layer_summary(
+    layered: &layers::Layers,
+    surface: &Surface,
+    topology: &Topology,
+    features: &Features,
+) -> LayerSummary {
     let mut reached: Vec<u32> = layered.vertex_layers.iter().flatten().copied().collect();
     reached.sort_unstable();
     let pick = |i: usize| reached.get(i).copied().unwrap_or(0);
-    // Fraction of the layered vertices of the given kinds that got their full stack.
-    let coverage = |kinds: &[VertexKind]| {
+    // Fraction of the layered vertices `counted` that got their full stack, and their number.
+    let coverage_where = |counted: &dyn Fn(usize) -> bool| {
         let (mut full, mut all) = (0usize, 0usize);
         for (v, (l, t)) in layered.vertex_layers.iter().zip(&layered.vertex_target).enumerate() {
             if let (Some(l), Some(t)) = (l, t) {
-                if kinds.contains(&features.vertex_kind[v]) {
+                if counted(v) {
                     all += 1;
                     full += usize::from(l >= t);
                 }
             }
         }
-        if all == 0 {
-            1.0
-        } else {
-            full as f64 / all as f64
-        }
+        (if all == 0 { 1.0 } else { full as f64 / all as f64 }, all)
     };
+    let coverage = |kinds: &[VertexKind]| coverage_where(&|v| kinds.contains(&features.vertex_kind[v])).0;
+    let reach: Vec<Option<f64>> = layered.vertex_thickness.iter().map(|t| t.map(|t| 2.0 * t)).collect();
+    let near = features.near_concave_ridges(surface, topology, &reach);
+    let (near_concave_coverage, near_concave_vertices) = coverage_where(&|v| near[v]);
     use VertexKind::*;
     LayerSummary {
         march: layered.stats.clone(),
@@ -347,6 +356,8 @@ fn layer_summary(layered: &layers::Layers, surface: &Surface, features: &Feature
         },
         concave_coverage: coverage(&[ConcaveRidge, ConcaveCorner, SaddleCorner]),
         convex_coverage: coverage(&[ConvexRidge, ConvexCorner, SaddleCorner]),
+        near_concave_coverage,
+        near_concave_vertices,
         stopped_vertices: layered.stopped_vertices.len(),
         stopped_examples: layered
             .stopped_vertices
@@ -376,13 +387,15 @@ impl std::fmt::Display for MeshReport {
         )?;
         writeln!(
             f,
-            "layers    min {} / median {} / max {}; full stack at {:.2}% of wall vertices ({:.2}% at concave, {:.2}% at convex features); {} stopped early",
+            "layers    min {} / median {} / max {}; full stack at {:.2}% of wall vertices ({:.2}% at concave, {:.2}% at convex features, {:.2}% of the {} within two thicknesses of a concave ridge); {} stopped early",
             l.layers_min,
             l.layers_median,
             l.layers_max,
             100.0 * l.full_coverage,
             100.0 * l.concave_coverage,
             100.0 * l.convex_coverage,
+            100.0 * l.near_concave_coverage,
+            l.near_concave_vertices,
             l.stopped_vertices
         )?;
         let sm = &l.smoothness;

@@ -40,6 +40,9 @@ pub struct Layers {
     pub vertex_layers: Vec<Option<u32>>,
     /// Target layer count of every wall vertex.
     pub vertex_target: Vec<Option<u32>>,
+    /// Target thickness of every wall vertex: its full stack's distance from the wall (the
+    /// largest over its columns; for a stack ended at isotropy, where it ended).
+    pub vertex_thickness: Vec<Option<f64>>,
     /// Where columns stopped early: wall vertex ids (all of them; the report shows a few).
     pub stopped_vertices: Vec<u32>,
     pub smoothness: smoothness::Smoothness,
@@ -88,6 +91,7 @@ pub fn build_layers(
     let smoothness = smoothness::measure(surface, &columns, &reached, growth, front_edges);
     let mut vertex_layers: Vec<Option<u32>> = vec![None; surface.points.len()];
     let mut vertex_target: Vec<Option<u32>> = vec![None; surface.points.len()];
+    let mut vertex_thickness: Vec<Option<f64>> = vec![None; surface.points.len()];
     let mut stopped_vertices = Vec::new();
     for c in 0..columns.len() {
         let v = columns.wall_vertex[c] as usize;
@@ -99,6 +103,9 @@ pub fn build_layers(
             let t = if columns.isotropic_ratio[carrier].is_nan() { t } else { reached };
             vertex_layers[v] = Some(vertex_layers[v].map_or(reached, |l| l.min(reached)));
             vertex_target[v] = Some(vertex_target[v].map_or(t, |x| x.max(t)));
+            if let Some(d) = columns.distance(c, t) {
+                vertex_thickness[v] = Some(vertex_thickness[v].map_or(d, |x: f64| x.max(d)));
+            }
             if reached < t {
                 stopped_vertices.push(v as u32);
             }
@@ -106,7 +113,7 @@ pub fn build_layers(
     }
     stopped_vertices.sort_unstable();
     stopped_vertices.dedup();
-    Layers { mesh, stats, vertex_layers, vertex_target, stopped_vertices, smoothness }
+    Layers { mesh, stats, vertex_layers, vertex_target, vertex_thickness, stopped_vertices, smoothness }
 }
 
 /// The layer stack of each column: that of the first front face using it, `None` if any face

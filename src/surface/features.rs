@@ -11,6 +11,7 @@
 use super::topology::{find, opposite_vertex, union, Topology};
 use super::Surface;
 use crate::geometry::predicates::{orient3d, Sign};
+use crate::geometry::DVec3;
 
 /// The default feature angle: an edge whose normals turn by more than this is a ridge.
 pub const DEFAULT_FEATURE_ANGLE_DEG: f64 = 30.0;
@@ -96,6 +97,60 @@ impl Features {
         let (edge_line, lines) = ridge_lines(topology, &edge_kind, &ridges_at);
         let counts = count_kinds(&edge_kind, &vertex_kind, &lines);
         Features { feature_angle_deg, turn_deg, edge_kind, vertex_kind, edge_line, lines, counts }
+    }
+}
+
+impl Features {
+    /// Whether each vertex lies within `radius[v]` of a concave ridge edge (`None`: not asked).
+    /// The ridge edges are binned on a grid of the largest radius, so each vertex looks at the
+    /// edges of the cells around its own only.
+    pub fn near_concave_ridges(
+        &self,
+        surface: &Surface,
+        topology: &Topology,
+        radius: &[Option<f64>],
+    ) -> Vec<bool> {
+        let reach = radius.iter().flatten().fold(0.0f64, |m, &r| m.max(r));
+        let ridges: Vec<[DVec3; 2]> = (0..topology.edges.len())
+            .filter(|&e| self.edge_kind[e] == EdgeKind::ConcaveRidge)
+            .map(|e| topology.edges[e].map(|v| surface.points[v as usize]))
+            .collect();
+        if ridges.is_empty() || !(reach > 0.0 && reach.is_finite()) {
+            return vec![false; radius.len()];
+        }
+        let cell = |p: DVec3| (p / reach).floor().as_i64vec3().to_array();
+        let mut grid: std::collections::HashMap<[i64; 3], Vec<u32>> = std::collections::HashMap::new();
+        for (i, &[a, b]) in ridges.iter().enumerate() {
+            // Samples at most half a cell apart: the closest point of the segment to a vertex
+            // within reach is within half a cell of one, so within two cells of the vertex's.
+            let samples = ((a.distance(b) / (0.5 * reach)).ceil() as usize).max(1);
+            let mut cells: Vec<[i64; 3]> =
+                (0..=samples).map(|k| cell(a.lerp(b, k as f64 / samples as f64))).collect();
+            cells.dedup();
+            for c in cells {
+                let edges = grid.entry(c).or_default();
+                if edges.last() != Some(&(i as u32)) {
+                    edges.push(i as u32);
+                }
+            }
+        }
+        let near = |v: usize, r: f64| {
+            let p = surface.points[v];
+            let c = cell(p);
+            (-2..=2).any(|dx| {
+                (-2..=2).any(|dy| {
+                    (-2..=2).any(|dz| {
+                        grid.get(&[c[0] + dx, c[1] + dy, c[2] + dz]).is_some_and(|edges| {
+                            edges.iter().any(|&i| {
+                                let [a, b] = ridges[i as usize];
+                                crate::geometry::distance::closest_point_on_segment(p, a, b).distance(p) <= r
+                            })
+                        })
+                    })
+                })
+            })
+        };
+        radius.iter().enumerate().map(|(v, r)| r.is_some_and(|r| near(v, r))).collect()
     }
 }
 
