@@ -100,13 +100,19 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
     let split_faces = splits.faces_with_splits(front.len());
     for f in 0..front.len() {
         let cols = front.face_columns(f);
-        if cols.len() != 3 || split_faces[f] {
+        if cols.len() != 3 || split_faces[f] || !cols.iter().all(|&c| columns.alive[c as usize]) {
+            continue;
+        }
+        // A pair gains only when one of its triangles is poor: most faces stop here (a pair
+        // is looked at from its poor face, so from both when both are).
+        let [p, q, r] = [0, 1, 2].map(|i| proposed[cols[i] as usize]);
+        if min_angle(p, q, r) >= POOR_ANGLE {
             continue;
         }
         for i in 0..3 {
             let (a, b, c) = (cols[i], cols[(i + 1) % 3], cols[(i + 2) % 3]);
             let Some(g) = opposite_face(front, f, a, b) else { continue };
-            if g < f || split_faces[g] || front.patch[g] != front.patch[f] {
+            if split_faces[g] || front.patch[g] != front.patch[f] {
                 continue;
             }
             let other = front.face_columns(g);
