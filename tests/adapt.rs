@@ -101,3 +101,17 @@ fn fans_stay_bounded() {
     assert!(off.max > 3.0, "{off:?}");
     assert!(on.p95 <= SQRT_2 && on.max <= 1.8, "{on:?}");
 }
+
+/// The full mesh (core included) of fandisk with `count = "auto"`: every front quad must take
+/// the core's pyramid. A corner-web quad whose one column a repair stopped after the crossing
+/// guard had looked at it once kept a twisted top that no pyramid fits, and the core failed.
+#[test]
+fn fandisk_auto_layers_make_a_full_mesh() {
+    let surface = fandisk();
+    let h0 = 1e-3 * surface.bounding_box().diagonal();
+    let config = Config::from_toml_str(&format!("[layers]\nfirst_height = {h0}\ncount = \"auto\"\n"))
+        .expect("a valid config");
+    let out = run(surface, &config, &MeshOptions { core: true }, Progress::hidden())
+        .expect("the core fits on the layers' front");
+    assert!(out.report.check.is_valid(), "{}", out.report.check);
+}

@@ -523,7 +523,13 @@ fn settle_slab(
         .filter(|&f| front.face_columns(f).iter().any(|&c| plan.moving[c as usize]))
         .collect();
     loop {
-        repair_invalid_cells(&mut plan, reshape, mesh, columns, front, to_check);
+        // The faces whose tops the repairs changed (a column stopped or merged, a split or swap
+        // given up) must be tested again too: a quad whose corner stopped may no longer be
+        // cappable.
+        let repaired = repair_invalid_cells(&mut plan, reshape, mesh, columns, front, to_check);
+        suspects.extend(repaired);
+        suspects.sort_unstable();
+        suspects.dedup();
         if guard.is_stale(k, &plan) {
             guard.rebuild(&plan, reshape, mesh, columns, front, reach(&plan, mesh, columns, k));
         }
@@ -550,7 +556,7 @@ fn settle_slab(
 /// columns.
 /// Collapses come first: an invalid cell without a crushed edge of its own may be mended by a
 /// collapse next to it (its neighbour crosses the bisector in another cell), so its columns stop
-/// only after a round that collapsed nothing.
+/// only after a round that collapsed nothing. Returns the faces whose cells changed.
 fn repair_invalid_cells(
     plan: &mut SlabPlan,
     reshape: &mut Reshape,
@@ -558,8 +564,9 @@ fn repair_invalid_cells(
     columns: &Columns,
     front: &Front,
     mut to_check: Vec<usize>,
-) {
+) -> Vec<usize> {
     let committed = mesh.points.len() as u32;
+    let mut changed_anywhere = Vec::new();
     while !to_check.is_empty() {
         let invalid: Vec<usize> = {
             let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
@@ -599,10 +606,14 @@ fn repair_invalid_cells(
         // the invalid ones left wait for the next round.
         to_check = front.faces_around_columns(&changed);
         to_check.extend(changed_faces);
+        changed_anywhere.extend_from_slice(&to_check);
         to_check.extend(uncollapsed);
         to_check.sort_unstable();
         to_check.dedup();
     }
+    changed_anywhere.sort_unstable();
+    changed_anywhere.dedup();
+    changed_anywhere
 }
 
 /// Where face `f`'s columns start on the wall, with their scales (for the debug log).
