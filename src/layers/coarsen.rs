@@ -1,7 +1,8 @@
 //! Tangential collapse of short front edges (issue 4, DESIGN.md "Tangential adaptivity"): a
 //! front edge whose proposed top is shorter than [`COLLAPSE_LENGTH`] against its size
-//! ([`Sizes::collapse_length`]: the target, or its length on the wall where shorter) merges its two columns into one, as the entropy collapse does
-//! ([`super::entropy::collapse`]): a column ends. It is the inverse of the split
+//! ([`Sizes::collapse_length`]: the target, or a part of its length on the wall where shorter)
+//! merges its two columns into one, as the entropy collapse does ([`super::entropy::collapse`]):
+//! a column ends. It is the inverse of the split
 //! ([`super::split`]): where the field coarsens (out of a refinement region) or the front
 //! compresses (concave walls), the front's edges stay near the wanted size.
 //!

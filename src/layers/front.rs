@@ -105,6 +105,12 @@ impl Columns {
         self.spec[c].filter(|s| k <= s.max_count()).map(|s| s.distance(k))
     }
 
+    /// The height of column `c`'s layer `k` (from `distance(c, k - 1)` to `distance(c, k)`), 0
+    /// when either is past its stack.
+    pub fn layer_height(&self, c: usize, k: u32) -> f64 {
+        self.distance(c, k).zip(self.distance(c, k - 1)).map_or(0.0, |(d, e)| d - e)
+    }
+
     /// The most layers column `c` may get (`None`: no layers).
     pub fn target(&self, c: usize) -> Option<u32> {
         self.spec[c].map(|s| s.max_count())

@@ -246,12 +246,11 @@ impl TopFront<'_> {
         let mut top: Vec<(u32, DVec3)> =
             self.front.face_columns(f).iter().map(|&c| self.node_and_position(c)).collect();
         if let Some(swapped) = self.reshape.swaps.swapped_face(f, self.plan) {
-            let d = swapped[0][2];
-            if !self.front.face_columns(f).contains(&d) {
-                top.push(self.node_and_position(d));
-            } else {
-                top.push(self.node_and_position(swapped[0][0]));
-            }
+            // The pair's fourth column, across the swapped edge.
+            let cols = self.front.face_columns(f);
+            top.extend(
+                swapped.iter().flatten().find(|c| !cols.contains(c)).map(|&c| self.node_and_position(c)),
+            );
             return (top, None);
         }
         let splits = &self.reshape.splits;

@@ -254,21 +254,19 @@ pub(super) fn propose(
     h: &[f64],
 ) -> Splits {
     let user = sizes.user(proposed, &columns.alive);
-    let height: Vec<f64> = (0..columns.len())
-        .map(|c| columns.distance(c, k).zip(columns.distance(c, k - 1)).map_or(0.0, |(d, e)| d - e))
-        .collect();
+    let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
     let mut long: Vec<([u32; 2], u32, u8)> = (0..front.len())
         .into_par_iter()
         .flat_map_iter(|f| {
             let cols = front.face_columns(f);
             let n = cols.len();
-            let (sizes, proposed) = ([h, &height[..], &user[..]], proposed);
+            let (limits, proposed) = ([h, &height[..], &user[..]], proposed);
             (0..n).filter_map(move |i| {
                 let (a, b) = (cols[i], cols[(i + 1) % n]);
                 let (ua, ub) = (a as usize, b as usize);
                 let live = columns.alive[ua] && columns.alive[ub];
                 let long = live
-                    && Sizes::split_length(columns, sizes, ua, ub, proposed[ub] - proposed[ua])
+                    && Sizes::split_length(columns, limits, ua, ub, proposed[ub] - proposed[ua])
                         > SPLIT_LENGTH;
                 long.then_some(([a.min(b), a.max(b)], f as u32, i as u8))
             })
@@ -420,7 +418,7 @@ pub(super) fn commit(
     for &s in &active {
         let [a, b] = splits.edges[s].map(|c| c as usize);
         let (base, dir, scale) = splits.start[s];
-        let step = columns.distance(a, k).zip(columns.distance(a, k - 1)).map_or(0.0, |(d, e)| d - e);
+        let step = columns.layer_height(a, k);
         new_column[s] = columns.push(ColumnStart {
             base,
             dir,

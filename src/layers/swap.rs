@@ -134,7 +134,7 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
         }
     }
     candidates.sort_by(|x, y| x.0.total_cmp(&y.0));
-    let mut swaps = Swaps { swaps: Vec::new(), on_face: Vec::new() };
+    let mut swaps = Swaps::default();
     if candidates.is_empty() {
         return swaps;
     }
@@ -142,10 +142,8 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
     let mut used_column = vec![false; columns.len()];
     for (_, swap) in candidates {
         let [f, g] = swap.faces.map(|x| x as usize);
-        if swaps.on_face[f] != u32::MAX || swaps.on_face[g] != u32::MAX {
-            continue;
-        }
-        // Swaps sharing a column would cut the same lateral faces two ways.
+        // Swaps sharing a column (so also those sharing a face) would cut the same lateral
+        // faces two ways.
         if swap.columns.iter().any(|&c| used_column[c as usize]) {
             continue;
         }
