@@ -437,6 +437,11 @@ impl std::fmt::Display for MeshReport {
                 )?;
                 writeln!(
                     f,
+                    "          {} seeds over the front (of {} front vertices with a layer under them)",
+                    c.seeds, c.seed_candidates
+                )?;
+                writeln!(
+                    f,
                     "          improvement: {} flips 2-3, {} 3-2, {} 4-4, {} larger edge removals, {} points smoothed, {} inserted ({:.2} s)",
                     i.flips_23, i.flips_32, i.flips_44, i.edge_removals, i.smoothed_points, i.inserted_points, i.seconds
                 )?;

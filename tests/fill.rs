@@ -255,11 +255,11 @@ fn spot_with_20_layers_fills_or_reports_the_crossing_front() {
 #[ignore = "diagnostic"]
 fn worst_core_tetrahedra() {
     use blmesh::fill::improve::{angle_quality, ImproveOptions, TetMesh};
-    use blmesh::fill::{fill_core_with, tetgen::TetGen, ClosedBoundary, CoreMesher, CoreTets, PointSizing};
+    use blmesh::fill::{fill_core_with, tetgen::TetGen, ClosedBoundary, CoreGuide, CoreMesher, CoreTets};
     use std::cell::RefCell;
     struct Capture(RefCell<Option<(ClosedBoundary, CoreTets)>>);
     impl CoreMesher for Capture {
-        fn fill(&self, b: &ClosedBoundary, s: &PointSizing) -> Result<CoreTets, FillError> {
+        fn fill(&self, b: &ClosedBoundary, s: &CoreGuide) -> Result<CoreTets, FillError> {
             let t = TetGen::default().fill(b, s)?;
             *self.0.borrow_mut() = Some((b.clone(), t.clone()));
             Ok(t)
@@ -312,4 +312,27 @@ fn worst_core_tetrahedra() {
             eprintln!("  smooth {v}: {:?}", mesh.smooth_vertex(*v).map(|c| (c.before, c.after)));
         }
     }
+}
+
+/// No size jump (issue 5): with `count = "auto"` the layers end isotropic, and the seeds over
+/// the front make the first core tetrahedron on a front triangle about as tall as the prism
+/// under it. Measured 90.0% within [1/r, r] on this sphere (examples/sphere.stl: 92.7%, and
+/// 34% before the seeds); the target of 95% is not met yet: a hundred front triangles keep a
+/// flat core tetrahedron whose fourth node is a front node (dents of the front where splits
+/// put nodes on chords), which the improvement then splits with a point close to the front.
+#[test]
+fn auto_layers_on_a_sphere_end_without_a_size_jump() {
+    let wall = shapes::icosphere(1.0, 3);
+    let config = Config {
+        layers: LayerSettings { count: Some(LayerCount::Auto), ..config(&wall, 1).layers },
+        ..Default::default()
+    };
+    let out = run(wall, &config, &MeshOptions { core: true }, Progress::hidden()).expect("the sphere meshes");
+    assert!(out.report.check.is_valid(), "{}", out.report.check);
+    let core = out.report.core.as_ref().expect("a core");
+    let jump = &core.size_jump.stats;
+    eprintln!("size jump: {jump:?}, seeds {} of {}", core.seeds, core.seed_candidates);
+    assert!(core.seeds > core.seed_candidates * 9 / 10, "{} seeds of {}", core.seeds, core.seed_candidates);
+    assert!(jump.within_band >= 0.85, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
+    assert!((0.9..1.15).contains(&jump.median), "median {}", jump.median);
 }

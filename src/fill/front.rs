@@ -220,3 +220,30 @@ impl CoreBuild {
         (ClosedBoundary { points, triangles, markers: self.markers.clone() }, nodes)
     }
 }
+
+impl CoreBuild {
+    /// The height of the prism under every boundary triangle (NaN where there is none: walls
+    /// without layers, the farfield, the pyramids' sides, and the other layer cells, whose
+    /// heights say less about the layer: a collapsed column's apex, a split cell's centre).
+    pub fn prism_heights(&self) -> Vec<f64> {
+        let index: HashMap<[u32; 3], usize> = (0..self.faces.len())
+            .filter(|&f| self.markers[f] == MARKER_FRONT)
+            .map(|f| (sorted_triangle(self.faces[f]), f))
+            .collect();
+        let mut height = vec![f64::NAN; self.faces.len()];
+        let x = |n: u32| self.mesh.points[n as usize];
+        let prisms = self.mesh.block(CellKind::Prism);
+        for (p, &zone) in prisms.iter().zip(&prisms.zone) {
+            let top = [p[3], p[4], p[5]];
+            if zone == self.core_zone {
+                continue;
+            }
+            if let Some(&f) = index.get(&sorted_triangle(top)) {
+                if let Ok(nodes) = <[u32; 6]>::try_from(p) {
+                    height[f] = super::size_jump::prism_height(nodes.map(x));
+                }
+            }
+        }
+        height
+    }
+}

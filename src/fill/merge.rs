@@ -4,7 +4,7 @@
 use std::collections::HashMap;
 
 use super::front::CoreBuild;
-use super::{sorted_triangle, ClosedBoundary, CoreStats, CoreTets, FillError};
+use super::{sorted_triangle, ClosedBoundary, CoreGuide, CoreStats, CoreTets, FillError};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -53,6 +53,56 @@ pub(super) fn check_boundary_kept(boundary: &ClosedBoundary, core: &CoreTets) ->
                 tets: tets_on[t],
             })
         }
+    }
+}
+
+/// The guide's interior points must follow the boundary points, unchanged. Returns how many of
+/// them the tetrahedra use.
+pub(super) fn check_interior_kept(
+    boundary: &ClosedBoundary,
+    guide: &CoreGuide,
+    core: &CoreTets,
+) -> Result<usize, FillError> {
+    let n = boundary.points.len();
+    for (i, p) in guide.interior.iter().enumerate() {
+        if core.points.get(n + i) != Some(p) {
+            return Err(FillError::BadOutput(format!(
+                "interior point {i} {:?} is not point {} of the output",
+                p.to_array(),
+                n + i
+            )));
+        }
+    }
+    let mut used = vec![false; guide.interior.len()];
+    for &v in core.tets.iter().flatten() {
+        if let Some(u) = (v as usize).checked_sub(n).and_then(|i| used.get_mut(i)) {
+            *u = true;
+        }
+    }
+    Ok(used.iter().filter(|&&u| u).count())
+}
+
+/// Drop the points after the first `fixed` that no tetrahedron uses (a mesher may leave an
+/// interior point it was given out of its mesh), renumbering the others.
+pub(super) fn drop_unused_points(core: &mut CoreTets, fixed: usize) {
+    let mut used = vec![false; core.points.len()];
+    for &v in core.tets.iter().flatten() {
+        used[v as usize] = true;
+    }
+    if used[fixed..].iter().all(|&u| u) {
+        return;
+    }
+    let mut new_index = vec![u32::MAX; core.points.len()];
+    let mut points = Vec::with_capacity(core.points.len());
+    for (i, p) in core.points.iter().enumerate() {
+        if i < fixed || used[i] {
+            new_index[i] = points.len() as u32;
+            points.push(*p);
+        }
+    }
+    core.points = points;
+    for t in &mut core.tets {
+        *t = t.map(|v| new_index[v as usize]);
     }
 }
 

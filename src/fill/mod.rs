@@ -11,6 +11,7 @@ pub mod farfield;
 mod front;
 pub mod improve;
 mod merge;
+pub mod seeds;
 pub mod size_jump;
 #[cfg(feature = "tetgen")]
 pub mod tetgen;
@@ -179,24 +180,41 @@ fn sorted_triangle(mut t: [u32; 3]) -> [u32; 3] {
     t
 }
 
-/// Target edge length of the tetrahedra at every boundary point; the mesher grades in between.
+/// What the mesher gets besides the boundary: points it must keep inside the region (the
+/// [`seeds`] over the front) and the target edge length at every boundary point and then every
+/// interior point; the mesher grades the sizes in between.
 #[derive(Clone, Debug, Default)]
-pub struct PointSizing {
+pub struct CoreGuide {
+    pub interior: Vec<DVec3>,
+    /// `boundary.points.len() + interior.len()` sizes, or none (the mesher's own sizes).
     pub size: Vec<f64>,
 }
 
-impl PointSizing {
-    /// The mean length of the boundary edges at every point (each edge counted once per
-    /// triangle using it, so both sides weigh alike).
-    pub fn mean_edge_length(boundary: &ClosedBoundary) -> PointSizing {
-        PointSizing {
+impl CoreGuide {
+    /// No interior points; at every boundary point the mean length of the boundary edges there
+    /// (each edge counted once per triangle using it, so both sides weigh alike).
+    pub fn mean_edge_length(boundary: &ClosedBoundary) -> CoreGuide {
+        CoreGuide {
+            interior: Vec::new(),
             size: crate::sizing::wall::mean_edge_length_per_vertex(&boundary.points, &boundary.triangles),
         }
+    }
+
+    /// [`CoreGuide::mean_edge_length`] and the seeds over the front (`prism_height`: the height
+    /// of the prism under every boundary triangle, see [`seeds::seed_points`]), each sized as
+    /// the front vertex under it.
+    pub fn with_seeds(boundary: &ClosedBoundary, prism_height: &[f64]) -> (CoreGuide, seeds::Seeds) {
+        let mut guide = CoreGuide::mean_edge_length(boundary);
+        let seeds = seeds::seed_points(boundary, prism_height, &guide.size);
+        guide.interior = seeds.points.clone();
+        let seed_sizes: Vec<f64> = seeds.vertex.iter().map(|&v| guide.size[v as usize]).collect();
+        guide.size.extend(seed_sizes);
+        (guide, seeds)
     }
 }
 
 /// What a [`CoreMesher`] returns: the boundary points first, unchanged and in order, then the
-/// points it added; tetrahedra positive in the Gmsh convention (`orient3d` positive).
+/// guide's interior points, then the points it added; tetrahedra positive in the Gmsh convention (`orient3d` positive).
 #[derive(Clone, Debug, Default)]
 pub struct CoreTets {
     pub points: Vec<DVec3>,
@@ -207,9 +225,10 @@ pub struct CoreTets {
 }
 
 /// Fills the region bounded by a [`ClosedBoundary`] with tetrahedra, keeping every boundary
-/// triangle as a face of exactly one tetrahedron (no point added on the boundary).
+/// triangle as a face of exactly one tetrahedron (no point added on the boundary) and every
+/// interior point of the guide as a node.
 pub trait CoreMesher {
-    fn fill(&self, boundary: &ClosedBoundary, sizing: &PointSizing) -> Result<CoreTets, FillError>;
+    fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError>;
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -264,12 +283,14 @@ pub struct CoreOptions {
     pub farfield: Option<FarfieldSpec>,
     /// Our improvement of the mesher's tetrahedra ([`improve`]).
     pub improve: improve::ImproveOptions,
+    /// Give the mesher a point over every front vertex at the last layer's height ([`seeds`]).
+    pub seed_front: bool,
 }
 
 impl Default for CoreOptions {
     /// External flow in the default box farfield.
     fn default() -> Self {
-        CoreOptions { farfield: Some(FarfieldSpec::default()), improve: Default::default() }
+        CoreOptions { farfield: Some(FarfieldSpec::default()), improve: Default::default(), seed_front: true }
     }
 }
 
@@ -280,7 +301,7 @@ impl CoreOptions {
             Flow::External => Some(FarfieldSpec { shape: config.farfield, ..Default::default() }),
             Flow::Internal => None,
         };
-        CoreOptions { farfield, improve: Default::default() }
+        CoreOptions { farfield, ..Default::default() }
     }
 }
 
@@ -290,8 +311,11 @@ pub struct CoreStats {
     pub tetrahedra: usize,
     /// Pyramids put on the quads of the front.
     pub pyramids: usize,
-    /// Points the mesher added inside the core.
+    /// Points inside the core: all of them (the seeds included), and the seeds over the front
+    /// of the candidates (front vertices with a layer under them).
     pub steiner_points: usize,
+    pub seeds: usize,
+    pub seed_candidates: usize,
     /// Points the mesher added on the boundary (0: the front is kept exactly).
     pub boundary_steiner_points: usize,
     /// Smallest and largest dihedral angle of the core tetrahedra, degrees.
@@ -372,15 +396,23 @@ pub fn fill_core_with_symmetry(
         (None, None) => {}
     }
     let (boundary, nodes) = core.closed_boundary();
-    let sizing = PointSizing::mean_edge_length(&boundary);
+    let (guide, seeds) = if options.seed_front {
+        CoreGuide::with_seeds(&boundary, &core.prism_heights())
+    } else {
+        (CoreGuide::mean_edge_length(&boundary), seeds::Seeds::default())
+    };
     let mesher_start = Instant::now();
-    let tets = mesher.fill(&boundary, &sizing)?;
+    let mut tets = mesher.fill(&boundary, &guide)?;
+    let seeds_used = merge::check_interior_kept(&boundary, &guide, &tets)?;
+    merge::drop_unused_points(&mut tets, boundary.points.len());
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     merge::check_boundary_kept(&boundary, &tets)?;
     let (tets, quality) = improve::improve_core(&boundary, tets, &options.improve);
     merge::check_boundary_kept(&boundary, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
     stats.quality = quality;
+    stats.seeds = seeds_used;
+    stats.seed_candidates = seeds.candidates;
     stats.boundary_steiner_points = tets.boundary_steiner_points;
     stats.mesher_seconds = mesher_seconds;
     stats.seconds = start.elapsed().as_secs_f64();

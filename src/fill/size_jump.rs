@@ -7,10 +7,9 @@ use std::collections::HashMap;
 
 use serde::Serialize;
 
-use crate::geometry::triangle_area_vector;
+use crate::geometry::{triangle_area_vector, DVec3};
 use crate::layers::smoothness::RatioStats;
 use crate::mesh::{CellKind, VolumeMesh};
-use crate::quality::validity::gather;
 
 /// The size-jump ratios and their histogram.
 #[derive(Clone, Debug, Default, Serialize)]
@@ -46,12 +45,14 @@ pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) 
     for (p, &zone) in prisms.nodes.chunks_exact(6).zip(&prisms.zone) {
         let top = [p[3], p[4], p[5]];
         if zone == layer_zone && top.iter().all(|&n| in_core[n as usize]) {
-            // The prism's volume over its top's area (exact for a right prism).
-            let Some(corners) = gather(&mesh.points, p) else { continue };
-            let volume = crate::quality::measures::volume(CellKind::Prism, &corners);
-            let area = triangle_area_vector(corners[3], corners[4], corners[5]).length() / 2.0;
-            if area > 0.0 {
-                last_height.insert(key(top), volume / area);
+            let (Ok(nodes), None) =
+                (<[u32; 6]>::try_from(p), p.iter().find(|&&n| n as usize >= in_core.len()))
+            else {
+                continue;
+            };
+            let height = prism_height(nodes.map(|n| mesh.points[n as usize]));
+            if height > 0.0 {
+                last_height.insert(key(top), height);
             }
         }
     }
@@ -70,6 +71,14 @@ pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) 
     SizeJump { histogram: histogram(&ratios, growth), stats: RatioStats::of(ratios, 1.0 / growth, growth) }
 }
 
+/// The height of a prism (Gmsh order, bottom `0 1 2`, top `3 4 5`) under its top: the mean
+/// distance of its bottom nodes from the top's plane. A prism that widens over a convex wall
+/// has a top larger than its bottom; its volume over its top's area would be less than that.
+pub fn prism_height(x: [DVec3; 6]) -> f64 {
+    let normal = triangle_area_vector(x[3], x[4], x[5]).normalize_or_zero();
+    x[..3].iter().map(|&b| (x[3] - b).dot(normal)).sum::<f64>() / 3.0
+}
+
 fn histogram(ratios: &[f64], growth: f64) -> Vec<(String, usize)> {
     let mut counts = vec![0usize; BIN_POWERS.len() + 1];
     for &q in ratios {
@@ -84,7 +93,16 @@ fn histogram(ratios: &[f64], growth: f64) -> Vec<(String, usize)> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::geometry::DVec3;
+
+    /// A prism widening upward (top twice the bottom's size) 0.5 high: its height is 0.5, its
+    /// volume over its top's area less.
+    #[test]
+    fn a_widening_prism_is_as_high_as_its_planes_are_apart() {
+        let bottom = [DVec3::ZERO, DVec3::X, DVec3::Y];
+        let top = bottom.map(|p| 2.0 * p + DVec3::new(-0.2, -0.2, 0.5));
+        let x = [bottom[0], bottom[1], bottom[2], top[0], top[1], top[2]];
+        assert!((prism_height(x) - 0.5).abs() < 1e-12);
+    }
 
     /// A prism of height 0.5 under a tetrahedron of height 1.5 on its top: ratio 3, outside
     /// the band for r = 1.2 and in the bin (r^4, r^8].

@@ -50,7 +50,7 @@ fn hole_points_lie_inside_bodies_only() {
 fn sizing_is_the_mean_edge_length() {
     let cube = shapes::cuboid(DVec3::splat(2.0), 1);
     let boundary = boundary_of(&cube);
-    let sizing = PointSizing::mean_edge_length(&boundary);
+    let sizing = CoreGuide::mean_edge_length(&boundary);
     // Every edge is 2 or 2 sqrt(2) long; each corner's mean lies between.
     assert!(sizing.size.iter().all(|&s| s > 2.0 && s < 2.0 * 2f64.sqrt()), "{:?}", sizing.size);
 }

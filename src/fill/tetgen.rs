@@ -20,13 +20,17 @@
 use std::ffi::{c_char, c_int, CString};
 use std::sync::Mutex;
 
-use super::{ClosedBoundary, CoreMesher, CoreTets, FillError, PointSizing};
+use super::{ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
 
-/// Circumradius of a regular tetrahedron over its edge length, sqrt(6)/4: TetGen's `-m` bounds
-/// circumradii, the sizing gives edge lengths.
-const CIRCUMRADIUS_PER_EDGE: f64 = 0.612_372_435_695_794_5;
+/// TetGen's `-m` bounds circumradii, the guide gives edge lengths: the largest circumradius
+/// per size. A regular tetrahedron has sqrt(6)/4 = 0.61, but the first core tetrahedra stand on
+/// a front triangle with a seed above one corner, like the corner of a cube (circumradius 0.87
+/// of its edge), and the front's edges vary around their mean: at 0.61 TetGen split most of
+/// them and put its own points at half the layer height (fandisk: 21% of the first core cells
+/// within [1/r, r] of the last layer, 66% at 1.2).
+const CIRCUMRADIUS_PER_SIZE: f64 = 1.2;
 
 /// TetGen with its quality and optimisation settings.
 #[derive(Clone, Debug, PartialEq)]
@@ -49,7 +53,11 @@ impl Default for TetGen {
         // has slivers it cannot improve (-Y keeps them), every pass visits them all again:
         // level 9 took minutes on the elbow's core, level 4 seconds. Our own pass
         // (`fill::improve`) follows.
-        TetGen { radius_edge: 1.4, min_dihedral: 18.0, optimisation: 4, optimisation_max_dihedral: 150.0 }
+        // Refinement for radius-edge 1.4 or dihedral angles of 18 degrees put a point near the
+        // front in a fifth of the first core cells (fandisk: 80% within [1/r, r] of the last
+        // layer, 92% at 2.0 and no bound on the angle) and the optimisation and our own pass
+        // bring the angles back: the same share below 15 degrees either way (0.3%).
+        TetGen { radius_edge: 2.0, min_dihedral: 0.0, optimisation: 4, optimisation_max_dihedral: 150.0 }
     }
 }
 
@@ -65,17 +73,14 @@ impl TetGen {
 }
 
 impl CoreMesher for TetGen {
-    fn fill(&self, boundary: &ClosedBoundary, sizing: &PointSizing) -> Result<CoreTets, FillError> {
-        let sized = !sizing.size.is_empty();
-        if sized && sizing.size.len() != boundary.points.len() {
-            return Err(FillError::Input(format!(
-                "{} sizes for {} points",
-                sizing.size.len(),
-                boundary.points.len()
-            )));
+    fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError> {
+        let sized = !guide.size.is_empty();
+        let points = boundary.points.len() + guide.interior.len();
+        if sized && guide.size.len() != points {
+            return Err(FillError::Input(format!("{} sizes for {points} points", guide.size.len())));
         }
-        let radii: Vec<f64> = sizing.size.iter().map(|s| s * CIRCUMRADIUS_PER_EDGE).collect();
-        let input = Input::new(boundary, sized.then_some(&radii[..]))?;
+        let radii: Vec<f64> = guide.size.iter().map(|s| s * CIRCUMRADIUS_PER_SIZE).collect();
+        let input = Input::new(boundary, &guide.interior, sized.then_some(&radii[..]))?;
         let output = run(&input, &self.switches(sized))?;
         output.into_core(boundary.points.len())
     }
@@ -91,12 +96,17 @@ struct Input {
 }
 
 impl Input {
-    fn new(boundary: &ClosedBoundary, sizes: Option<&[f64]>) -> Result<Input, FillError> {
+    /// The boundary and the interior points after it (TetGen inserts the points no facet uses
+    /// as they are, and lists its input points first in its output).
+    fn new(boundary: &ClosedBoundary, interior: &[DVec3], sizes: Option<&[f64]>) -> Result<Input, FillError> {
         let fits = |count: usize, what: &str| {
             c_int::try_from(count)
                 .map_err(|_| FillError::Input(format!("{count} {what} are too many for TetGen")))
         };
-        fits(boundary.points.len(), "points")?;
+        fits(boundary.points.len() + interior.len(), "points")?;
+        if let Some(p) = interior.iter().position(|p| !p.is_finite()) {
+            return Err(FillError::Input(format!("interior point {p} is not finite: {:?}", interior[p])));
+        }
         fits(boundary.triangles.len(), "triangles")?;
         if let Some(p) = sizes.and_then(|s| s.iter().position(|x| !(x.is_finite() && *x >= 0.0))) {
             return Err(FillError::Input(format!("the size at point {p} is not a length")));
@@ -105,7 +115,7 @@ impl Input {
         boundary.check_no_self_intersection()?;
         let holes = boundary.hole_points()?;
         Ok(Input {
-            points: boundary.points.iter().flat_map(|p| p.to_array()).collect(),
+            points: boundary.points.iter().chain(interior).flat_map(|p| p.to_array()).collect(),
             sizes: sizes.map(<[f64]>::to_vec),
             // Node indices are < the point count, which fits c_int.
             triangles: boundary.triangles.iter().flatten().map(|&v| v as c_int).collect(),
@@ -285,7 +295,7 @@ mod tests {
     #[test]
     fn switches_keep_the_boundary_and_bound_the_quality() {
         let s = TetGen::default().switches(true);
-        assert!(s.starts_with("pYMzQq1.4000/18.0000O4/7"), "{s}");
+        assert!(s.starts_with("pYMzQq2.0000/0.0000O4/7"), "{s}");
         assert!(s.ends_with('m'));
         assert!(!TetGen::default().switches(false).contains('m'));
     }
