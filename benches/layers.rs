@@ -37,6 +37,7 @@ fn main() {
         growth: Some(1.2),
         count: Some(LayerCount::Fixed(20)),
         thickness: None,
+        transition: Some(false),
     };
     let spec = LayerSpec::resolve(&settings, body_size).expect("a valid layer spec");
     let patch_spec = vec![Some(spec); surface.patch_names.len()];

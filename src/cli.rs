@@ -115,6 +115,10 @@ struct MeshArgs {
     /// Do not split or collapse the layers' front edges to the tangential sizes (tangential adaptivity).
     #[arg(long)]
     no_adapt: bool,
+    /// Stop at the layer count or thickness even where the last layer is still thinner than the
+    /// front is wide (no transition layers up to isotropic cells).
+    #[arg(long)]
+    no_transition: bool,
     /// Write MSH as ASCII instead of binary.
     #[arg(long)]
     ascii: bool,
@@ -300,6 +304,11 @@ fn mesh_config(args: &MeshArgs) -> Result<Config> {
     config.fan_angle = args.fan_angle.or(config.fan_angle);
     if args.no_adapt {
         config.sizing.adapt = Some(false);
+    }
+    if args.no_transition {
+        // The flag overrides the file's patch rules too.
+        config.layers.transition = Some(false);
+        config.patches.iter_mut().for_each(|p| p.layers.transition = Some(false));
     }
     config.validate()?;
     Ok(config)

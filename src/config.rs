@@ -139,6 +139,9 @@ pub struct LayerSettings {
     pub growth: Option<f64>,
     pub count: Option<LayerCount>,
     pub thickness: Option<f64>,
+    /// After a fixed count (or thickness), go on growing at the same rate until the cells are
+    /// isotropic, so that the core starts at the last layer's size (default true).
+    pub transition: Option<bool>,
 }
 
 impl LayerSettings {
@@ -150,6 +153,7 @@ impl LayerSettings {
             // A count and a thickness exclude each other: the more specific source wins both.
             count: if over.thickness.is_some() { over.count } else { over.count.or(self.count) },
             thickness: if over.count.is_some() { over.thickness } else { over.thickness.or(self.thickness) },
+            transition: over.transition.or(self.transition),
         }
     }
 }
@@ -386,6 +390,8 @@ pub struct LayerSpec {
     pub first_height: f64,
     pub growth: f64,
     pub count: LayerCount,
+    /// Transition layers after a fixed count ([`LayerSettings::transition`]).
+    pub transition: bool,
     /// See [`LayerSpec::max_count`].
     max_count: u32,
 }
@@ -400,17 +406,46 @@ impl LayerSpec {
             (None, Some(t)) => LayerCount::Fixed(layers_for_thickness(first_height, growth, t)?),
             (None, None) => LayerCount::Fixed(DEFAULT_LAYER_COUNT),
         };
+        let transition = s.transition.unwrap_or(true);
         let max_count = match (count, s.thickness) {
+            (LayerCount::Fixed(n), _) if transition => n.max(AUTO_MAX_LAYERS),
             (LayerCount::Fixed(n), _) => n,
             (LayerCount::Auto, Some(t)) => layers_for_thickness(first_height, growth, t)?,
             (LayerCount::Auto, None) => AUTO_MAX_LAYERS,
         };
-        Ok(LayerSpec { first_height, growth, count, max_count })
+        Ok(LayerSpec { first_height, growth, count, transition, max_count })
     }
 
-    /// The most layers a column gets: the fixed count, or the cap of an automatic one.
+    /// The most layers a column gets: the fixed count (with transition layers: the cap of an
+    /// automatic count, or the fixed count if more), or the cap of an automatic one.
     pub fn max_count(&self) -> u32 {
         self.max_count
+    }
+
+    /// The same stack ending at its count: no transition layers.
+    pub fn without_transition(self) -> LayerSpec {
+        match self.count {
+            LayerCount::Fixed(n) => LayerSpec { transition: false, max_count: n, ..self },
+            LayerCount::Auto => LayerSpec { transition: false, ..self },
+        }
+    }
+
+    /// The layers of a full stack, what coverage is measured against: the fixed count (the
+    /// transition layers after it are extra), or the cap of an automatic one.
+    pub fn full_count(&self) -> u32 {
+        match self.count {
+            LayerCount::Fixed(n) => n,
+            LayerCount::Auto => self.max_count,
+        }
+    }
+
+    /// Whether layer `k` (1-based) ends where its cells would be isotropic: every layer of an
+    /// automatic count, the transition layers after a fixed one.
+    pub fn stops_when_isotropic(&self, k: u32) -> bool {
+        match self.count {
+            LayerCount::Fixed(n) => self.transition && k > n,
+            LayerCount::Auto => true,
+        }
     }
 
     /// The layer count, unless it is decided while marching (`count = "auto"`).
@@ -505,6 +540,24 @@ mod tests {
         assert!(Config::from_toml_str("unknown_key = 1").is_err());
     }
 
+    /// A fixed count goes on to isotropy after its layers unless `transition = false`; the
+    /// full stack stays the count.
+    #[test]
+    fn transition_layers_follow_a_fixed_count() {
+        let spec = |toml: &str| {
+            let c = Config::from_toml_str(toml).unwrap();
+            LayerSpec::resolve(&c.layers, 1.0).unwrap()
+        };
+        let on = spec("[layers]\ncount = 8\n");
+        assert!(on.transition && on.full_count() == 8 && on.max_count() == AUTO_MAX_LAYERS);
+        assert!(!on.stops_when_isotropic(8) && on.stops_when_isotropic(9));
+        let off = spec("[layers]\ncount = 8\ntransition = false\n");
+        assert!(off.full_count() == 8 && off.max_count() == 8 && !off.stops_when_isotropic(9));
+        let auto = spec("[layers]\ncount = \"auto\"\n");
+        assert!(auto.stops_when_isotropic(1) && auto.full_count() == AUTO_MAX_LAYERS);
+        assert_eq!(spec("[layers]\ncount = 80\n").max_count(), 80);
+    }
+
     #[test]
     fn yplus_resolves_the_first_height_from_the_flow_conditions() {
         let c = Config::from_toml_str(
@@ -535,8 +588,13 @@ mod tests {
 
     #[test]
     fn thickness_gives_the_fewest_layers_reaching_it() {
-        let s =
-            LayerSettings { first_height: Some(1.0), growth: Some(2.0), thickness: Some(7.0), count: None };
+        let s = LayerSettings {
+            first_height: Some(1.0),
+            growth: Some(2.0),
+            thickness: Some(7.0),
+            count: None,
+            transition: None,
+        };
         let spec = LayerSpec::resolve(&s, 1.0).unwrap();
         assert_eq!(spec.count, LayerCount::Fixed(3)); // 1 + 2 + 4 = 7
         assert_eq!(spec.distance(3), 7.0);

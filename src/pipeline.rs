@@ -141,7 +141,7 @@ pub fn run(
     warnings.extend(config.unmatched_rules(&surface.patch_names).into_iter().map(|pattern| {
         format!("[[patch]] match = {pattern:?} matches no patch (it must match a whole name)")
     }));
-    let patch_spec = patch_layer_specs(&surface, config, body_size)?;
+    let mut patch_spec = patch_layer_specs(&surface, config, body_size)?;
     let layered_patch: Vec<bool> = patch_spec.iter().map(Option::is_some).collect();
     let symmetry_patch: Vec<bool> =
         surface.patch_names.iter().map(|name| config.patch_settings(name).0 == Role::Symmetry).collect();
@@ -149,6 +149,17 @@ pub fn run(
     // their planes first.
     let planes = constraint::snap_planar_patches(&mut surface, &layered_patch);
     warnings.extend(not_planar_warnings(&surface, &layered_patch, &planes));
+    if planes.iter().any(Option::is_some) && patch_spec.iter().flatten().any(|s| s.transition) {
+        // Stacks that grow on to isotropy can cross each other in a sliding plane where two
+        // fronts meet on it (the ONERA M6's trailing edge at its root, also with
+        // `count = "auto"`), and nothing guards the plane yet.
+        warnings.push(
+            "no transition layers where columns slide on a planar patch without layers: the \
+             stacks end at their count"
+                .to_owned(),
+        );
+        patch_spec.iter_mut().flatten().for_each(|s| *s = s.without_transition());
+    }
     let (topology, features) = timings.time("features", || {
         let topology = Topology::new(&surface);
         let features = Features::compute(&surface, &topology, config.feature_angle());
@@ -250,7 +261,7 @@ fn picture_spots(
 ) -> Vec<crate::picture::PictureSpot> {
     use crate::picture::PictureSpot;
     use crate::surface::features::{EdgeKind, VertexKind};
-    let thickness = patch_spec.iter().flatten().map(|s| s.distance(s.max_count())).fold(0.0, f64::max);
+    let thickness = patch_spec.iter().flatten().map(|s| s.distance(s.full_count())).fold(0.0, f64::max);
     let edge = |e: usize| topology.edges[e].map(|v| surface.points[v as usize]);
     let spot = |name: &str, origin: crate::geometry::DVec3, along: [crate::geometry::DVec3; 2]| PictureSpot {
         name: name.to_owned(),
@@ -437,7 +448,7 @@ impl std::fmt::Display for MeshReport {
                 )?;
                 writeln!(
                     f,
-                    "          {} seeds over the front (of {} front vertices with a layer under them)",
+                    "          {} seeds over the front in place (of {} front vertices with a prism under them)",
                     c.seeds, c.seed_candidates
                 )?;
                 writeln!(

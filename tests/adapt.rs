@@ -31,7 +31,7 @@ fn fandisk() -> Surface {
 /// they march, and collapsed again where the size grows (gradation 1.2) out of it.
 fn refined_sphere(region: &str) -> MeshOutput {
     let toml = format!(
-        "[layers]\nfirst_height = 0.005\ngrowth = 1.2\ncount = 12\n\
+        "[layers]\nfirst_height = 0.005\ngrowth = 1.2\ncount = 12\ntransition = false\n\
          [[sizing.regions]]\nshape = \"sphere\"\n{region}\nsize = 0.02\n"
     );
     let out = mesh(&shapes::icosphere(1.0, 3), &toml);
@@ -90,7 +90,7 @@ fn stacks_end_at_isotropy() {
 #[test]
 fn fans_stay_bounded() {
     let surface = shapes::cuboid(DVec3::new(2.0, 1.5, 1.0), 6);
-    let layers = "[layers]\nfirst_height = 0.005\ngrowth = 1.1\ncount = 40\n";
+    let layers = "[layers]\nfirst_height = 0.005\ngrowth = 1.1\ncount = 40\ntransition = false\n";
     let on = mesh(&surface, layers).report.layers.smoothness.fan_edge_length;
     let off = mesh(&surface, &format!("{layers}[sizing]\nadapt = false\n"))
         .report

@@ -75,6 +75,12 @@ fn elbow_internal_flow_has_layers_on_the_walls_and_planar_inlet_and_outlet() {
         assert!(m.boundary.triangles.iter().all(|t| !input.contains(&sorted(*t))));
     }
     let layers = &out.report.layers;
+    // Sliding columns: no transition layers, and a warning says so.
+    assert!(
+        out.report.warnings.iter().any(|w| w.contains("no transition layers")),
+        "{:?}",
+        out.report.warnings
+    );
     assert!(layers.layers_max == 5 && layers.layers_median == 5);
     assert!(layers.full_coverage > 0.95, "coverage {}", layers.full_coverage);
     // Internal flow: the mesh fills the pipe, whose volume the input surface encloses.

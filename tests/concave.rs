@@ -16,6 +16,7 @@ fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
             growth: Some(1.2),
             count: Some(LayerCount::Fixed(layers)),
             thickness: None,
+            transition: Some(false),
         },
         ..Default::default()
     };

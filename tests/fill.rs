@@ -26,6 +26,7 @@ fn config(surface: &Surface, count: u32) -> Config {
             growth: Some(1.2),
             count: Some(LayerCount::Fixed(count)),
             thickness: None,
+            transition: None,
         },
         ..Default::default()
     }

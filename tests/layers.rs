@@ -23,6 +23,7 @@ fn mesh_layers(surface: &Surface) -> (MeshOutput, f64) {
             growth: Some(GROWTH),
             count: Some(LayerCount::Fixed(LAYERS)),
             thickness: None,
+            transition: Some(false),
         },
         ..Default::default()
     };
@@ -151,6 +152,7 @@ fn auto_count_stops_at_isotropy_smoothly() {
                 growth: Some(GROWTH),
                 count: Some(LayerCount::Auto),
                 thickness: None,
+                transition: None,
             },
             ..Default::default()
         };
@@ -168,6 +170,40 @@ fn auto_count_stops_at_isotropy_smoothly() {
     }
 }
 
+/// Transition layers (issue 5, the default): after a fixed count of thin layers, the stacks of
+/// the box and the sphere go on growing until their cells are isotropic, as with
+/// `count = "auto"`; every stack counts as full once it has the count, and the last layers end
+/// within the growth ratio of the front's size. Without them, the stacks end at the count.
+#[test]
+fn transition_layers_carry_a_fixed_count_to_isotropy() {
+    for surface in [shapes::cuboid(DVec3::new(2.0, 1.5, 1.0), 6), shapes::icosphere(1.0, 3)] {
+        let settings = |transition| LayerSettings {
+            first_height: Some(1e-3 * surface.bounding_box().diagonal()),
+            growth: Some(GROWTH),
+            count: Some(LayerCount::Fixed(5)),
+            thickness: None,
+            transition,
+        };
+        let mesh = |transition| {
+            let config = Config { layers: settings(transition), ..Default::default() };
+            run(surface.clone(), &config, &MeshOptions { core: false }, Progress::hidden())
+                .expect("meshing a valid surface succeeds")
+        };
+        let (with, without) = (mesh(None), mesh(Some(false)));
+        for out in [&with, &without] {
+            assert!(out.report.check.is_valid(), "{}", out.report.check);
+            assert_eq!(out.report.layers.full_coverage, 1.0);
+            assert!(out.report.layers.layers_min >= 5);
+        }
+        assert_eq!(without.report.layers.layers_max, 5);
+        let layers = &with.report.layers;
+        assert!(layers.layers_median > 10, "{} layers", layers.layers_median);
+        let iso = &layers.smoothness.isotropy_ratio;
+        assert!(iso.count > 0 && iso.max < 1.0 && iso.median > 1.0 / GROWTH, "{iso:?}");
+        assert_eq!(layers.smoothness.layer_height_ratio.within_band, 1.0);
+    }
+}
+
 /// Patch-wise layer settings (issue 6): the arrow's fins get a first height 4 times smaller than
 /// the body, its cap 2 times. The first heights are graded across the patch borders, so
 /// neighbouring stacks differ by at most one growth ratio (measured over all wall edges, apart
@@ -179,7 +215,7 @@ fn patch_settings_meet_without_steps() {
     )
     .expect("the arrow reads");
     let config = Config::from_toml_str(
-        "[layers]\nfirst_height = 0.01\ncount = 10\n\
+        "[layers]\nfirst_height = 0.01\ncount = 10\ntransition = false\n\
          [[patch]]\nmatch = \"fin.*\"\nfirst_height = 0.0025\n\
          [[patch]]\nmatch = \"cap\"\nfirst_height = 0.005\n",
     )

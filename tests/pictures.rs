@@ -24,6 +24,7 @@ fn box_layers() -> VolumeMesh {
             growth: Some(1.2),
             count: Some(LayerCount::Fixed(10)),
             thickness: None,
+            transition: Some(false),
         },
         ..Default::default()
     };

@@ -214,7 +214,7 @@ impl CoreGuide {
 }
 
 /// What a [`CoreMesher`] returns: the boundary points first, unchanged and in order, then the
-/// guide's interior points, then the points it added; tetrahedra positive in the Gmsh convention (`orient3d` positive).
+/// points inside (the guide's, where it kept them, and its own); tetrahedra positive in the Gmsh convention (`orient3d` positive).
 #[derive(Clone, Debug, Default)]
 pub struct CoreTets {
     pub points: Vec<DVec3>,
@@ -225,8 +225,8 @@ pub struct CoreTets {
 }
 
 /// Fills the region bounded by a [`ClosedBoundary`] with tetrahedra, keeping every boundary
-/// triangle as a face of exactly one tetrahedron (no point added on the boundary) and every
-/// interior point of the guide as a node.
+/// triangle as a face of exactly one tetrahedron (no point added on the boundary), starting
+/// from the guide's interior points (which it may still move or remove).
 pub trait CoreMesher {
     fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError>;
 }
@@ -312,7 +312,7 @@ pub struct CoreStats {
     /// Pyramids put on the quads of the front.
     pub pyramids: usize,
     /// Points inside the core: all of them (the seeds included), and the seeds over the front
-    /// of the candidates (front vertices with a layer under them).
+    /// the mesher kept in place, of the candidates (front vertices with a prism under them).
     pub steiner_points: usize,
     pub seeds: usize,
     pub seed_candidates: usize,
@@ -403,7 +403,7 @@ pub fn fill_core_with_symmetry(
     };
     let mesher_start = Instant::now();
     let mut tets = mesher.fill(&boundary, &guide)?;
-    let seeds_used = merge::check_interior_kept(&boundary, &guide, &tets)?;
+    let seeds_used = merge::interior_points_in_place(&boundary, &guide, &tets);
     merge::drop_unused_points(&mut tets, boundary.points.len());
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     merge::check_boundary_kept(&boundary, &tets)?;

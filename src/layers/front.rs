@@ -116,9 +116,16 @@ impl Columns {
         self.spec[c].map(|s| s.max_count())
     }
 
-    /// Column `c`'s stack ends where its cells become isotropic (`count = "auto"`).
-    pub fn stops_when_isotropic(&self, c: usize) -> bool {
-        self.spec[c].is_some_and(|s| s.fixed_count().is_none())
+    /// Column `c`'s layer `k` ends where its cells become isotropic (`count = "auto"`, or a
+    /// transition layer after a fixed count).
+    pub fn stops_when_isotropic(&self, c: usize, k: u32) -> bool {
+        self.spec[c].is_some_and(|s| s.stops_when_isotropic(k))
+    }
+
+    /// The layers of column `c`'s full stack (`None`: no layers), see
+    /// [`LayerSpec::full_count`].
+    pub fn full_count(&self, c: usize) -> Option<u32> {
+        self.spec[c].map(|s| s.full_count())
     }
 
     /// Whether `a` and `b` start from the same wall point (copies of a vertex in a fan): the

@@ -302,7 +302,7 @@ pub fn march(
                 columns.alive[c] = false;
             }
         }
-        if (0..columns.len()).any(|c| columns.stops_when_isotropic(c)) {
+        if (0..columns.len()).any(|c| columns.stops_when_isotropic(c, k)) {
             let wall_size = matches!(sizes.adapt, Adapt::Off).then_some(sizes.wall.as_slice());
             stop_isotropic_columns(mesh, columns, front, k, wall_size);
         }
@@ -376,7 +376,7 @@ fn stop_isotropic_columns(
         cliff || d - d_before >= wall_size.map_or(size[c], |w| size[c].min(w[c]))
     };
     let candidates: Vec<bool> =
-        (0..columns.len()).map(|c| columns.alive[c] && columns.stops_when_isotropic(c)).collect();
+        (0..columns.len()).map(|c| columns.alive[c] && columns.stops_when_isotropic(c, k)).collect();
     // The columns of one wall vertex (a fan) end together: a fan strip cell with one side
     // stopped and the other moving would be flat.
     let mut vertex_ends = vec![false; columns.wall_vertex_count()];

@@ -95,12 +95,12 @@ pub fn build_layers(
     let mut stopped_vertices = Vec::new();
     for c in 0..columns.len() {
         let v = columns.wall_vertex[c] as usize;
-        if let Some(t) = columns.target(c) {
+        if let Some(t) = columns.full_count(c) {
             // A column that merged is carried on by the bisector column it merged into.
             let carrier = columns.carrier(c);
             let reached = columns.layers[carrier];
-            // A stack ended at isotropy is complete.
-            let t = if columns.isotropic_ratio[carrier].is_nan() { t } else { reached };
+            // A stack ended at isotropy is complete (even before its full count).
+            let t = if columns.isotropic_ratio[carrier].is_nan() { t } else { reached.min(t) };
             vertex_layers[v] = Some(vertex_layers[v].map_or(reached, |l| l.min(reached)));
             vertex_target[v] = Some(vertex_target[v].map_or(t, |x| x.max(t)));
             if let Some(d) = columns.distance(c, t) {

@@ -13,6 +13,7 @@ pub fn layered_box() -> (Surface, Config) {
         growth: Some(1.2),
         count: Some(LayerCount::Fixed(5)),
         thickness: None,
+        transition: Some(false),
     };
     (surface, Config { layers, ..Default::default() })
 }
