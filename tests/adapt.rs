@@ -62,7 +62,10 @@ fn a_front_inside_then_out_of_a_refinement_sphere_is_split_then_collapsed() {
     let out = refined_sphere("center = [0.0, 0.0, 0.0]\nradius = 1.1");
     let march = &out.report.layers.march;
     assert!(march.splits > 10_000 && march.tangential_collapses > 1000, "{march:?}");
-    assert_in_metric_band("out of a region", &out.report.layers.smoothness.front_edge_length, 0.93);
+    // Measured 92.8% (96.0% while split nodes were born on the chord between their parents:
+    // on the arc, without the dents, the front is a little larger and more of the diagonals the
+    // last layers' splits make end just over sqrt 2).
+    assert_in_metric_band("out of a region", &out.report.layers.smoothness.front_edge_length, 0.92);
 }
 
 /// `count = "auto"` on the box and on fandisk, with the wall's own sizes: the last layer's

@@ -297,9 +297,9 @@ pub(super) fn propose(
     splits
 }
 
-/// The column born at the middle of `edge` in layer `k`: from the middle of its ends' wall
-/// points (the wall vertex itself for a fan edge), along their mean direction and scale, its top
-/// the middle of theirs pushed along that direction onto the layer's distance. `None` where the
+/// The column born at the middle of `edge` in layer `k`: from the middle of the arc between its
+/// ends' wall points (the wall vertex itself for a fan edge), along their mean direction and
+/// scale, its top the middle of theirs pushed along that direction onto the layer's distance. `None` where the
 /// ends slide differently or point opposite ways.
 fn new_column(
     columns: &Columns,
@@ -313,7 +313,8 @@ fn new_column(
     }
     let dir = (columns.dir[a] + columns.dir[b]).try_normalize()?;
     let scale = 0.5 * (columns.scale[a] + columns.scale[b]);
-    let base = 0.5 * (columns.base[a] + columns.base[b]);
+    let (p, q) = (columns.base[a], columns.base[b]);
+    let base = 0.5 * (p + q) + dir * arc_rise(p, columns.dir[a], q, columns.dir[b]);
     let d = columns.distance(a, k)?;
     let middle = 0.5 * (proposed[a] + proposed[b]);
     let top = columns.slide[a].project(middle + dir * (scale * d - (middle - base).dot(dir)));
@@ -401,6 +402,23 @@ pub fn subdivide(corners: &[u32], mids: &[u32]) -> Vec<Vec<u32>> {
     }
 }
 
+/// How far the middle of the circular arc through `p` and `q` with normals `n_p` and `n_q` lies
+/// from the chord's middle, along their mean normal: `|q - p| / 2 tan(angle / 4)`, positive where
+/// the normals open along the chord (convex). A node born at the chord's middle sits in a dent
+/// of the front, and the core's mesher fills a dent with a flat tetrahedron on front nodes.
+fn arc_rise(p: DVec3, n_p: DVec3, q: DVec3, n_q: DVec3) -> f64 {
+    let angle = n_p.angle_between(n_q);
+    if !angle.is_finite() || angle == 0.0 {
+        return 0.0;
+    }
+    let rise = 0.5 * p.distance(q) * (0.25 * angle).tan();
+    if (n_q - n_p).dot(q - p) >= 0.0 {
+        rise
+    } else {
+        -rise
+    }
+}
+
 /// Add the columns of the splits made under `plan` (`mid_node[s]` is split `s`'s top node) and
 /// subdivide the front faces on their edges; the front's adjacency must be rebuilt after.
 /// Returns how many columns were added.
@@ -447,6 +465,21 @@ pub(super) fn commit(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// On a circle of radius 2 the middle of the arc between two points rises above their
+    /// chord's middle by R (1 - cos(phi)); on the inside of the circle (normals converging) it
+    /// sinks by as much; between parallel normals it does not move.
+    #[test]
+    fn the_arc_middle_rises_on_convex_walls_and_sinks_on_concave_ones() {
+        let (r, phi) = (2.0f64, 0.3f64);
+        let p = DVec3::new(-r * phi.sin(), r * phi.cos(), 0.0);
+        let q = DVec3::new(r * phi.sin(), r * phi.cos(), 0.0);
+        let (n_p, n_q) = (p / r, q / r);
+        let rise = r * (1.0 - phi.cos());
+        assert!((arc_rise(p, n_p, q, n_q) - rise).abs() < 1e-12);
+        assert!((arc_rise(p, -n_p, q, -n_q) + rise).abs() < 1e-12);
+        assert_eq!(arc_rise(p, DVec3::Y, q, DVec3::Y), 0.0);
+    }
     use crate::mesh::CellKind;
 
     #[test]
