@@ -20,7 +20,7 @@ use serde::Serialize;
 use super::{sorted_triangle, ClosedBoundary, CoreTets, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
 use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::predicates::{orient3d, Sign};
-use crate::geometry::{triangle_area_vector, Aabb, DVec3};
+use crate::geometry::{triangle_area_vector, DVec3};
 use crate::mesh::CellKind;
 use crate::quality::measures::{dihedral_range, edge_face_pairs};
 
@@ -935,60 +935,8 @@ fn gap_across_nearest(bvh: &TriangleBvh, p: DVec3) -> (f64, f64) {
     let direction = area.normalize_or_zero();
     // Hits closer than this are the nearest triangle's neighbours at the starting point.
     let skip = 1e-9 * inradius;
-    let mut best = f64::INFINITY;
-    bvh.branch_and_bound(
-        |bounds| ray_box_entry(near.point, direction, bounds),
-        |t, corners| {
-            if t != near.triangle {
-                if let Some(s) = ray_triangle(near.point, direction, corners).filter(|&s| s > skip) {
-                    best = best.min(s);
-                }
-            }
-            best
-        },
-    );
+    let best = bvh.first_hit(near.point, direction, skip, |t| t == near.triangle).unwrap_or(f64::INFINITY);
     (best, inradius)
-}
-
-/// Where the ray `origin + s direction`, `s >= 0`, enters the box (0 inside it; infinite if
-/// it misses).
-fn ray_box_entry(origin: DVec3, direction: DVec3, bounds: &Aabb) -> f64 {
-    let (mut enter, mut leave) = (0.0f64, f64::INFINITY);
-    for axis in 0..3 {
-        let (o, d) = (origin[axis], direction[axis]);
-        let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
-        if d == 0.0 {
-            if o < lo || o > hi {
-                return f64::INFINITY;
-            }
-            continue;
-        }
-        let (s0, s1) = ((lo - o) / d, (hi - o) / d);
-        enter = enter.max(s0.min(s1));
-        leave = leave.min(s0.max(s1));
-    }
-    if enter <= leave {
-        enter
-    } else {
-        f64::INFINITY
-    }
-}
-
-/// The ray parameter where `origin + s direction` crosses the triangle (Moller-Trumbore;
-/// floating point: the census only measures).
-fn ray_triangle(origin: DVec3, direction: DVec3, [a, b, c]: &[DVec3; 3]) -> Option<f64> {
-    let (e1, e2) = (*b - *a, *c - *a);
-    let h = direction.cross(e2);
-    let det = e1.dot(h);
-    if det.abs() < 1e-300 {
-        return None;
-    }
-    let offset = origin - *a;
-    let u = offset.dot(h) / det;
-    let q = offset.cross(e1);
-    let v = direction.dot(q) / det;
-    let s = e2.dot(q) / det;
-    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s >= 0.0).then_some(s)
 }
 
 /// What the improvement found and did, for the report.

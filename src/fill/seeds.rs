@@ -22,9 +22,6 @@ const LOWEST_PER_SIZE: f64 = 0.7;
 /// ...and at most this: a tetrahedron much taller than its base is wide is a needle (a last
 /// layer a little taller than the front is wide still gets its match).
 const HIGHEST_PER_SIZE: f64 = 1.3;
-/// A seed's height over the layer's: a little above 1, since a seed's neighbours' triangles see
-/// it a little lower than its own (they lean away from its normal).
-const RAISE: f64 = 1.05;
 /// Every front triangle at the vertex must face the seed's direction at least this much
 /// (cosine): at a sharper crease of the front the seed would lean over a neighbour.
 const MIN_NORMAL_COSINE: f64 = 0.5;
@@ -113,7 +110,7 @@ fn candidates(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]) -> 
         .filter(|&v| on_front[v] && min_cosine[v] >= MIN_NORMAL_COSINE && area[v] > 0.0 && size[v] > 0.0)
         .map(|v| {
             let layer = height[v] / area[v];
-            let h = (RAISE * layer).clamp(LOWEST_PER_SIZE * size[v], HIGHEST_PER_SIZE * size[v]);
+            let h = layer.clamp(LOWEST_PER_SIZE * size[v], HIGHEST_PER_SIZE * size[v]);
             // Where the front bends, the triangles around see a seed on the vertex's normal
             // lower by their cosine: raise it so that they see it at `h` on the mean (at a
             // convex crease, the mitred offset).
@@ -223,7 +220,7 @@ mod tests {
         let seeds = seed_points(&boundary, &heights, &size);
         assert_eq!(seeds.vertex, vec![4], "{seeds:?}");
         let p = seeds.points[0];
-        assert!((p - DVec3::new(1.0, 1.0, 0.9 * RAISE)).length() < 1e-12, "{p:?}");
+        assert!((p - DVec3::new(1.0, 1.0, 0.9)).length() < 1e-12, "{p:?}");
     }
 
     #[test]

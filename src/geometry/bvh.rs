@@ -154,6 +154,30 @@ impl TriangleBvh {
         }
     }
 
+    /// The nearest crossing beyond `skip` of the ray `origin + s direction` (`s >= 0`) with a
+    /// triangle that `ignore` does not rule out (floating point, see [`ray_triangle`]).
+    pub fn first_hit(
+        &self,
+        origin: DVec3,
+        direction: DVec3,
+        skip: f64,
+        ignore: impl Fn(u32) -> bool,
+    ) -> Option<f64> {
+        let mut best = f64::INFINITY;
+        self.branch_and_bound(
+            |bounds| ray_box_entry(origin, direction, bounds),
+            |t, corners| {
+                if !ignore(t) {
+                    if let Some(s) = ray_triangle(origin, direction, corners).filter(|&s| s > skip) {
+                        best = best.min(s);
+                    }
+                }
+                best
+            },
+        );
+        best.is_finite().then_some(best)
+    }
+
     /// For every node, the minimum of `value(triangle)` over its subtree.
     pub fn node_minimum(&self, value: impl Fn(u32) -> f64) -> Vec<f64> {
         let mut out = vec![f64::INFINITY; self.nodes.len()];
@@ -178,6 +202,47 @@ impl TriangleBvh {
 pub fn box_distance_squared(p: DVec3, b: &Aabb) -> f64 {
     let gap = (b.min - p).max(p - b.max).max(DVec3::ZERO);
     gap.length_squared()
+}
+
+/// Where the ray `origin + s direction`, `s >= 0`, enters the box (0 inside it; infinite if
+/// it misses).
+pub fn ray_box_entry(origin: DVec3, direction: DVec3, bounds: &Aabb) -> f64 {
+    let (mut enter, mut leave) = (0.0f64, f64::INFINITY);
+    for axis in 0..3 {
+        let (o, d) = (origin[axis], direction[axis]);
+        let (lo, hi) = (bounds.min[axis], bounds.max[axis]);
+        if d == 0.0 {
+            if o < lo || o > hi {
+                return f64::INFINITY;
+            }
+            continue;
+        }
+        let (s0, s1) = ((lo - o) / d, (hi - o) / d);
+        enter = enter.max(s0.min(s1));
+        leave = leave.min(s0.max(s1));
+    }
+    if enter <= leave {
+        enter
+    } else {
+        f64::INFINITY
+    }
+}
+
+/// The ray parameter where `origin + s direction` crosses the triangle (Moller-Trumbore, in
+/// floating point: for measures and margins, never for topology).
+pub fn ray_triangle(origin: DVec3, direction: DVec3, [a, b, c]: &[DVec3; 3]) -> Option<f64> {
+    let (e1, e2) = (*b - *a, *c - *a);
+    let h = direction.cross(e2);
+    let det = e1.dot(h);
+    if det.abs() < 1e-300 {
+        return None;
+    }
+    let offset = origin - *a;
+    let u = offset.dot(h) / det;
+    let q = offset.cross(e1);
+    let v = direction.dot(q) / det;
+    let s = e2.dot(q) / det;
+    (u >= 0.0 && v >= 0.0 && u + v <= 1.0 && s >= 0.0).then_some(s)
 }
 
 #[cfg(test)]
