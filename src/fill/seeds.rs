@@ -36,7 +36,8 @@ pub struct Seeds {
     pub points: Vec<DVec3>,
     /// The front vertex under every seed (a boundary point index).
     pub vertex: Vec<u32>,
-    /// Front vertices with a layer height under them (the candidates).
+    /// Front vertices with a prism under them and a normal their triangles face (the
+    /// candidates).
     pub candidates: usize,
 }
 
@@ -65,8 +66,12 @@ pub fn seed_points(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]
 
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
+    /// The front vertex under it.
     vertex: u32,
+    /// Where it stands: on the vertex's normal, `height` over the triangles around on the mean
+    /// (further from the vertex where the front bends).
     point: DVec3,
+    /// Its height over the front: the layer's, within the bounds of the front's size.
     height: f64,
 }
 
