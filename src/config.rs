@@ -448,14 +448,6 @@ impl LayerSpec {
         }
     }
 
-    /// The layer count, unless it is decided while marching (`count = "auto"`).
-    pub fn fixed_count(&self) -> Option<u32> {
-        match self.count {
-            LayerCount::Fixed(n) => Some(n),
-            LayerCount::Auto => None,
-        }
-    }
-
     /// Height of layer `k` (0-based).
     pub fn height(&self, k: u32) -> f64 {
         self.first_height * self.growth.powi(k as i32)

@@ -233,12 +233,9 @@ impl CoreBuild {
         let mut height = vec![f64::NAN; self.faces.len()];
         let x = |n: u32| self.mesh.points[n as usize];
         let prisms = self.mesh.block(CellKind::Prism);
-        for (p, &zone) in prisms.iter().zip(&prisms.zone) {
-            let top = [p[3], p[4], p[5]];
-            if zone == self.core_zone {
-                continue;
-            }
-            if let Some(&f) = index.get(&sorted_triangle(top)) {
+        // Every prism is a layer cell: the core adds pyramids only.
+        for p in prisms.iter() {
+            if let Some(&f) = index.get(&sorted_triangle([p[3], p[4], p[5]])) {
                 if let Ok(nodes) = <[u32; 6]>::try_from(p) {
                     height[f] = super::size_jump::prism_height(nodes.map(x));
                 }

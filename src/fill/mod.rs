@@ -214,7 +214,8 @@ impl CoreGuide {
 }
 
 /// What a [`CoreMesher`] returns: the boundary points first, unchanged and in order, then the
-/// points inside (the guide's, where it kept them, and its own); tetrahedra positive in the Gmsh convention (`orient3d` positive).
+/// points inside (the guide's, where it kept them, and its own); tetrahedra positive in the
+/// Gmsh convention (`orient3d` positive).
 #[derive(Clone, Debug, Default)]
 pub struct CoreTets {
     pub points: Vec<DVec3>,
