@@ -9,6 +9,10 @@
 //! column has `1/sin(phi/2)`, a corner column more, a face column 1), so the merged node stays on
 //! the Voronoi bisector at the exact wall distance. Between two columns of the same kind the
 //! merged column goes through the middle of their proposals, along their mean direction.
+//!
+//! Where the wall's edges run obliquely to a ridge, a face can turn over with no edge shrinking
+//! much: a corner overtakes its opposite edge (the bisector column passing the face columns in
+//! front of it). Such a face loses that corner instead, merged into the nearer end of the edge.
 
 use glam::DVec3;
 
@@ -70,9 +74,86 @@ pub(super) fn collapse_crushed_edge(
     columns: &Columns,
     points: &[DVec3],
 ) -> Option<Vec<u32>> {
-    area_ratio(plan, front, f, columns, points).filter(|&r| r < 1.0)?;
-    let root = collapse_most_shrunk_edge(plan, front, f, columns, points)?;
+    let crushed = area_ratio(plan, front, f, columns, points).is_some_and(|r| r < 1.0);
+    let root = crushed
+        .then(|| collapse_most_shrunk_edge(plan, front, f, columns, points))
+        .flatten()
+        .or_else(|| collapse_crossing_corner(plan, front, f, columns, points))?;
     Some(plan.merges.group(root).collect())
+}
+
+/// Collapse the corner of triangle `f` that is crossing its opposite edge into the nearer end
+/// of that edge, if the front allows it; returns the surviving root. This is a bisector column
+/// overtaking the face columns in front of it along a ridge whose wall edges run obliquely to
+/// it: no edge of the face shrinks much while the face turns over, and the face's bottom may
+/// already be nearly flat (its area says nothing then).
+fn collapse_crossing_corner(
+    plan: &mut SlabPlan,
+    front: &Front,
+    f: usize,
+    columns: &Columns,
+    points: &[DVec3],
+) -> Option<u32> {
+    let (_, v, ends) = crossing_corner(plan, front, f, columns, points)?;
+    let w = ends.into_iter().find(|&w| can_merge(plan, front, columns, v, w))?;
+    collapse(plan, columns, v, w);
+    Some(plan.merges.root(v))
+}
+
+/// Whether roots `v` and `w` may merge: both moving, the front stays a manifold, and they are
+/// not two columns of one fan or columns that slide differently.
+fn can_merge(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, w: u32) -> bool {
+    moving_roots(plan, v, w)
+        && !columns.is_fan_edge(v as usize, w as usize)
+        && columns.slide[v as usize] == columns.slide[w as usize]
+        && plan.merges.can_collapse(front, v, w)
+}
+
+/// The corner of triangle `f` (after the merges so far) whose height over its opposite edge
+/// falls most this layer, if it keeps less than [`MEETING_RATIO`] of it: the ratio, the corner
+/// and the ends of its edge, nearer end (at the proposed tops) first. Heights are seen along the
+/// face's mean column direction.
+fn crossing_corner(
+    plan: &SlabPlan,
+    front: &Front,
+    f: usize,
+    columns: &Columns,
+    points: &[DVec3],
+) -> Option<(f64, u32, [u32; 2])> {
+    let face = plan.merges.resolved_face(front, f)?;
+    let &[a, b, c] = face.nodes() else { return None };
+    let bottom = |r: u32| points[columns.node[r as usize] as usize];
+    let top = |r: u32| plan.proposed[r as usize];
+    let axis =
+        (columns.dir[a as usize] + columns.dir[b as usize] + columns.dir[c as usize]).normalize_or_zero();
+    let height_ratio = |v: u32, [w0, w1]: [u32; 2]| {
+        let at_bottom = corner_height(axis, bottom(v), bottom(w0), bottom(w1));
+        let at_top = corner_height(axis, top(v), top(w0), top(w1));
+        if at_bottom > 0.0 {
+            at_top / at_bottom
+        } else {
+            f64::INFINITY
+        }
+    };
+    let (ratio, v, mut ends) = [(a, [b, c]), (b, [c, a]), (c, [a, b])]
+        .into_iter()
+        .map(|(v, e)| (height_ratio(v, e), v, e))
+        .filter(|&(ratio, _, _)| ratio < MEETING_RATIO)
+        .min_by(|x, y| x.0.total_cmp(&y.0))?;
+    let nearer = |w: u32| top(v).distance_squared(top(w));
+    ends.sort_by(|x, y| nearer(*x).total_cmp(&nearer(*y)));
+    Some((ratio, v, ends))
+}
+
+/// Signed distance of corner `v` from the line through `a` and `b`, seen along `axis`
+/// (positive on the side where `a`, `b`, `v` turn counter-clockwise about it).
+fn corner_height(axis: DVec3, v: DVec3, a: DVec3, b: DVec3) -> f64 {
+    let edge = b - a;
+    let across = edge.cross(axis).length();
+    if across == 0.0 {
+        return 0.0;
+    }
+    axis.dot(edge.cross(v - a)) / across
 }
 
 /// Collapse the edge of face `f` whose top has shrunk most relative to its bottom, if the
@@ -128,6 +209,20 @@ pub(super) fn collapse(plan: &mut SlabPlan, columns: &Columns, a: u32, b: u32) {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// A corner overtaking its opposite edge while no edge of the triangle shrinks much.
+    #[test]
+    fn corner_height_sees_a_corner_crossing_its_edge() {
+        let (v, a, b) = (DVec3::new(0.0, -0.3, 0.0), DVec3::new(1.0, 0.0, 0.0), DVec3::new(-1.0, 0.0, 0.0));
+        let up = DVec3::Z;
+        assert!((corner_height(up, v, a, b) - 0.3).abs() < 1e-12);
+        // Seen along a tilted axis, heights scale but keep their sign.
+        assert!(corner_height((up + 0.3 * DVec3::Y).normalize(), v, a, b) > 0.0);
+        let crossed = v + up + 0.4 * DVec3::Y;
+        assert!(corner_height(up, crossed, a + up, b + up) < 0.0);
+        // Its edges from v keep most of their length along the bottom edges.
+        assert!(shrink_ratio(v, a, crossed, a + up) > 0.6);
+    }
 
     #[test]
     fn shrink_ratio_tells_parallel_converging_and_crossed() {
