@@ -85,7 +85,8 @@ pub struct LayerSummary {
     pub layers_min: u32,
     pub layers_median: u32,
     pub layers_max: u32,
-    /// Fraction of layered wall vertices that reached their full stack.
+    /// Fraction of layered wall vertices that reached their full stack, or stopped at the
+    /// medial surface of a thin gap (as thick as the gap allows).
     pub full_coverage: f64,
     /// The same over the vertices on concave ridges and at concave or saddle corners, and over
     /// those on convex ridges and at convex or saddle corners (1 when there are none).
@@ -95,9 +96,12 @@ pub struct LayerSummary {
     /// fronts meet (1 when there are none), and how many they are.
     pub near_concave_coverage: f64,
     pub near_concave_vertices: usize,
-    /// Wall vertices whose column stopped before its target, with a few examples.
+    /// Wall vertices whose column stopped before its target (not at a gap's medial surface),
+    /// with a few examples.
     pub stopped_vertices: usize,
     pub stopped_examples: Vec<[f64; 3]>,
+    /// Wall vertices whose column stopped at the medial surface of a thin gap.
+    pub gap_limited_vertices: usize,
     pub smoothness: crate::layers::smoothness::Smoothness,
 }
 
@@ -338,13 +342,17 @@ fn layer_summary(
     reached.sort_unstable();
     let pick = |i: usize| reached.get(i).copied().unwrap_or(0);
     // Fraction of the layered vertices `counted` that got their full stack, and their number.
+    let mut gap_limited = vec![false; layered.vertex_layers.len()];
+    for &v in &layered.gap_limited_vertices {
+        gap_limited[v as usize] = true;
+    }
     let coverage_where = |counted: &dyn Fn(usize) -> bool| {
         let (mut full, mut all) = (0usize, 0usize);
         for (v, (l, t)) in layered.vertex_layers.iter().zip(&layered.vertex_target).enumerate() {
             if let (Some(l), Some(t)) = (l, t) {
                 if counted(v) {
                     all += 1;
-                    full += usize::from(l >= t);
+                    full += usize::from(l >= t || gap_limited[v]);
                 }
             }
         }
@@ -376,6 +384,7 @@ fn layer_summary(
             .take(5)
             .map(|&v| surface.points[v as usize].to_array())
             .collect(),
+        gap_limited_vertices: layered.gap_limited_vertices.len(),
         smoothness: layered.smoothness.clone(),
     }
 }
@@ -398,7 +407,7 @@ impl std::fmt::Display for MeshReport {
         )?;
         writeln!(
             f,
-            "layers    min {} / median {} / max {}; full stack at {:.2}% of wall vertices ({:.2}% at concave, {:.2}% at convex features, {:.2}% of the {} within two thicknesses of a concave ridge); {} stopped early",
+            "layers    min {} / median {} / max {}; full stack at {:.2}% of wall vertices ({:.2}% at concave, {:.2}% at convex features, {:.2}% of the {} within two thicknesses of a concave ridge); {} stopped early, {} at the medial surface of a thin gap (counted as full)",
             l.layers_min,
             l.layers_median,
             l.layers_max,
@@ -407,7 +416,8 @@ impl std::fmt::Display for MeshReport {
             100.0 * l.convex_coverage,
             100.0 * l.near_concave_coverage,
             l.near_concave_vertices,
-            l.stopped_vertices
+            l.stopped_vertices,
+            l.gap_limited_vertices
         )?;
         let sm = &l.smoothness;
         write!(

@@ -112,3 +112,23 @@ fn v_grooves_of_60_90_120_degrees_keep_every_layer() {
         assert!(err < 0.02, "{name}: top front off the exact offset by {:.2}% of the thickness", 100.0 * err);
     }
 }
+
+/// Thin gaps (issue 7): `mech_test_gapdetection.obj` has holes narrower than two stack
+/// thicknesses. Their fronts stop where they meet, at the medial surface, and those stacks
+/// count as full; the rest of the wall keeps its layers, and the mesh is valid.
+#[test]
+fn thin_gaps_stop_at_the_medial_surface() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/mech_test_gapdetection.obj");
+    let surface = blmesh::io::read_surface(path.as_ref()).expect("reads");
+    let h0 = 1e-3 * surface.bounding_box().diagonal();
+    let (out, _) = mesh(&surface, h0, 10);
+    let r = &out.report;
+    assert!(r.check.is_valid(), "{}", r.check);
+    let l = &r.layers;
+    eprintln!(
+        "mech: full {:.3}, {} stopped early, {} at the medial surface of a gap",
+        l.full_coverage, l.stopped_vertices, l.gap_limited_vertices
+    );
+    assert!(l.gap_limited_vertices >= 10, "the holes' walls stop at their axes");
+    assert!(l.full_coverage >= 0.85, "full stacks (or gap-limited) at {:.3} of the wall", l.full_coverage);
+}

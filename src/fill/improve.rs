@@ -935,7 +935,8 @@ fn gap_across_nearest(bvh: &TriangleBvh, p: DVec3) -> (f64, f64) {
     let direction = area.normalize_or_zero();
     // Hits closer than this are the nearest triangle's neighbours at the starting point.
     let skip = 1e-9 * inradius;
-    let best = bvh.first_hit(near.point, direction, skip, |t| t == near.triangle).unwrap_or(f64::INFINITY);
+    let best =
+        bvh.first_hit(near.point, direction, skip, |t| t == near.triangle).map_or(f64::INFINITY, |hit| hit.0);
     (best, inradius)
 }
 

@@ -155,27 +155,30 @@ impl TriangleBvh {
     }
 
     /// The nearest crossing beyond `skip` of the ray `origin + s direction` (`s >= 0`) with a
-    /// triangle that `ignore` does not rule out (floating point, see [`ray_triangle`]).
+    /// triangle that `ignore` does not rule out (floating point, see [`ray_triangle`]): its `s`
+    /// and the triangle.
     pub fn first_hit(
         &self,
         origin: DVec3,
         direction: DVec3,
         skip: f64,
         ignore: impl Fn(u32) -> bool,
-    ) -> Option<f64> {
-        let mut best = f64::INFINITY;
+    ) -> Option<(f64, u32)> {
+        let mut best = (f64::INFINITY, u32::MAX);
         self.branch_and_bound(
             |bounds| ray_box_entry(origin, direction, bounds),
             |t, corners| {
                 if !ignore(t) {
                     if let Some(s) = ray_triangle(origin, direction, corners).filter(|&s| s > skip) {
-                        best = best.min(s);
+                        if s < best.0 {
+                            best = (s, t);
+                        }
                     }
                 }
-                best
+                best.0
             },
         );
-        best.is_finite().then_some(best)
+        best.0.is_finite().then_some(best)
     }
 
     /// For every node, the minimum of `value(triangle)` over its subtree.

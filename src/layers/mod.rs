@@ -8,6 +8,7 @@ pub mod coarsen;
 pub mod collapse;
 pub mod entropy;
 pub mod front;
+pub mod gap;
 pub mod guard;
 pub mod march;
 pub mod slab;
@@ -43,8 +44,12 @@ pub struct Layers {
     /// Target thickness of every wall vertex: its full stack's distance from the wall (the
     /// largest over its columns; for a stack ended at isotropy, where it ended).
     pub vertex_thickness: Vec<Option<f64>>,
-    /// Where columns stopped early: wall vertex ids (all of them; the report shows a few).
+    /// Where columns stopped early: wall vertex ids (all of them; the report shows a few), not
+    /// counting those stopped at the medial surface of a thin gap.
     pub stopped_vertices: Vec<u32>,
+    /// Wall vertices whose columns stopped early at the medial surface of a thin gap
+    /// ([`gap::gap_limited`]): their stacks are as thick as the gap allows.
+    pub gap_limited_vertices: Vec<u32>,
     pub smoothness: smoothness::Smoothness,
 }
 
@@ -113,7 +118,19 @@ pub fn build_layers(
     }
     stopped_vertices.sort_unstable();
     stopped_vertices.dedup();
-    Layers { mesh, stats, vertex_layers, vertex_target, vertex_thickness, stopped_vertices, smoothness }
+    let limited = gap::gap_limited(surface, &columns, &mesh.points, &stopped_vertices);
+    let (gap_limited_vertices, stopped_vertices) =
+        stopped_vertices.into_iter().partition(|&v| limited[v as usize]);
+    Layers {
+        mesh,
+        stats,
+        vertex_layers,
+        vertex_target,
+        vertex_thickness,
+        stopped_vertices,
+        gap_limited_vertices,
+        smoothness,
+    }
 }
 
 /// The layer stack of each column: that of the first front face using it, `None` if any face

@@ -1,0 +1,140 @@
+//! Thin gaps: where the wall faces itself across less than two stack thicknesses, the fronts
+//! from the two sides meet at the medial surface between them, and the crossing guard ends
+//! their stacks there rather than let them cross. Such a stack is as thick as the gap allows,
+//! so it counts as reached (issue 7): the medial surface is the bisector of the two walls.
+//!
+//! A column that stopped early is gap-limited when the ray along its direction from its wall
+//! point meets the wall again, facing it (the two normals within [`FACING_ANGLE_DEG`] of
+//! opposite), and its top, with the layer it could not build, reaches half way across. The
+//! fronts at a concave ridge do not face each other this way (the rays run along the other
+//! wall), so a stop there is never excused.
+
+use glam::DVec3;
+use rayon::prelude::*;
+
+use super::front::Columns;
+use crate::geometry::bvh::TriangleBvh;
+use crate::surface::Surface;
+
+/// Walls whose normals are within this angle of opposite face each other across a gap.
+pub const FACING_ANGLE_DEG: f64 = 30.0;
+
+/// Hits nearer than this fraction of the column's first layer height are the wall at the
+/// column's own vertex.
+const OWN_WALL: f64 = 1e-3;
+
+/// For every wall vertex of `stopped` (ids into the surface's points), whether a column of it
+/// that stopped early is gap-limited; `points` are the layered mesh's points. (The columns of a
+/// fan end together: on the rim of a narrow hole the fan's columns into the hole end at its
+/// axis, and those along the face beside it end with them.)
+pub fn gap_limited(surface: &Surface, columns: &Columns, points: &[DVec3], stopped: &[u32]) -> Vec<bool> {
+    let mut limited = vec![false; surface.points.len()];
+    if stopped.is_empty() {
+        return limited;
+    }
+    let bvh = TriangleBvh::new((0..surface.triangles.len()).map(|t| surface.triangle_points(t)).collect());
+    let mut is_stopped = vec![false; surface.points.len()];
+    for &v in stopped {
+        is_stopped[v as usize] = true;
+    }
+    let short: Vec<(usize, bool)> = (0..columns.len())
+        .into_par_iter()
+        .filter(|&c| is_stopped[columns.wall_vertex[c] as usize] && stopped_early(columns, c))
+        .map(|c| (columns.wall_vertex[c] as usize, reaches_medial_surface(surface, &bvh, columns, points, c)))
+        .collect();
+    for (v, ok) in short {
+        limited[v] |= ok;
+    }
+    limited
+}
+
+/// Whether column `c` (or the column it merged into) has fewer layers than its full count.
+fn stopped_early(columns: &Columns, c: usize) -> bool {
+    let carrier = columns.carrier(c);
+    columns
+        .full_count(c)
+        .is_some_and(|t| columns.layers[carrier] < t && columns.isotropic_ratio[carrier].is_nan())
+}
+
+/// Whether the stack of column `c` ends within one layer of the medial surface of a gap.
+fn reaches_medial_surface(
+    surface: &Surface,
+    bvh: &TriangleBvh,
+    columns: &Columns,
+    points: &[DVec3],
+    c: usize,
+) -> bool {
+    let (base, dir) = (columns.base[c], columns.dir[c]);
+    let Some(first) = columns.spec[c].map(|s| s.first_height) else { return false };
+    let Some((across, t)) = bvh.first_hit(base, dir, OWN_WALL * first, |_| false) else { return false };
+    if surface.triangle_normal(t as usize).dot(dir) > -FACING_ANGLE_DEG.to_radians().cos() {
+        return false;
+    }
+    let carrier = columns.carrier(c);
+    let k = columns.layers[carrier];
+    let rise = (points[columns.node[carrier] as usize] - base).dot(dir);
+    // The layer it could not build (or, past its stack, its last one).
+    let next = match columns.layer_height(carrier, k + 1) {
+        h if h > 0.0 => h,
+        _ => columns.layer_height(carrier, k.max(1)),
+    };
+    rise + columns.scale[carrier] * next >= 0.5 * across
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::{LayerCount, LayerSettings, LayerSpec};
+    use crate::layers::front::ColumnStart;
+    use crate::normals::constraint::Slide;
+
+    /// A wall vertex at the origin facing +z, and a wall triangle over it at `height` facing
+    /// down (or tilted by `tilt` radians about x).
+    fn gap_case(height: f64, tilt: f64, top: f64) -> bool {
+        let n = DVec3::new(0.0, tilt.sin(), -tilt.cos());
+        let (u, w) = (DVec3::X, n.cross(DVec3::X));
+        let centre = DVec3::new(0.0, 0.0, height);
+        // Counter-clockwise about n.
+        let lid = [centre - u - w, centre + u - w, centre + w];
+        let floor = [DVec3::new(-1.0, -1.0, 0.0), DVec3::new(1.0, -1.0, 0.0), DVec3::new(0.0, 1.0, 0.0)];
+        let surface = Surface {
+            points: [floor, lid].concat(),
+            triangles: vec![[0, 1, 2], [3, 4, 5]],
+            triangle_patch: vec![0, 0],
+            patch_names: vec!["wall".into()],
+        };
+        assert!(surface.triangle_normal(1).dot(n) > 0.999);
+        let settings = LayerSettings {
+            first_height: Some(0.01),
+            growth: Some(1.2),
+            count: Some(LayerCount::Fixed(10)),
+            thickness: None,
+            transition: Some(false),
+        };
+        let spec = LayerSpec::resolve(&settings, 1.0).unwrap();
+        let mut columns = Columns::default();
+        columns.push(ColumnStart {
+            base: DVec3::ZERO,
+            dir: DVec3::Z,
+            scale: 1.0,
+            node: 6,
+            layers: 3,
+            wall_vertex: 0,
+            slide: Slide::Free,
+            spec: Some(spec),
+            last_step: 0.0,
+        });
+        let mut points = surface.points.clone();
+        points.push(DVec3::new(0.0, 0.0, top));
+        gap_limited(&surface, &columns, &points, &[0])[0]
+    }
+
+    #[test]
+    fn a_stack_stopped_half_way_across_a_gap_is_limited_by_it() {
+        // Three layers from 0.01 by 1.2 reach 0.0364; the fourth would add 0.0173.
+        assert!(gap_case(0.1, 0.0, 0.0364), "0.054 reaches the middle of a 0.1 gap");
+        assert!(!gap_case(0.2, 0.0, 0.0364), "a 0.2 gap: stopped well short of its middle");
+        assert!(!gap_case(0.1, 1.0, 0.0364), "a wall at 57 degrees does not face it");
+        assert!(gap_case(0.1, 0.4, 0.0364), "a wall at 23 degrees does");
+    }
+}
