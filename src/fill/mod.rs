@@ -403,11 +403,8 @@ pub fn fill_core_with_symmetry(
         (CoreGuide::mean_edge_length(&boundary), seeds::Seeds::default())
     };
     let mesher_start = Instant::now();
-    let mut tets = mesher.fill(&boundary, &guide)?;
-    let seeds_used = merge::interior_points_in_place(&boundary, &guide, &tets);
-    merge::drop_unused_points(&mut tets, boundary.points.len());
+    let (tets, seeds_used) = fill_keeping_boundary(mesher, &boundary, guide)?;
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
-    merge::check_boundary_kept(&boundary, &tets)?;
     let (tets, quality) = improve::improve_core(&boundary, tets, &options.improve);
     merge::check_boundary_kept(&boundary, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
@@ -418,6 +415,55 @@ pub fn fill_core_with_symmetry(
     stats.mesher_seconds = mesher_seconds;
     stats.seconds = start.elapsed().as_secs_f64();
     Ok((mesh, stats))
+}
+
+/// Times the mesher is run again, with the seeds near the boundary triangle it lost removed,
+/// before the seeds are given up.
+const SEED_RETRIES: usize = 3;
+
+/// Seeds within this many local sizes of a boundary triangle the mesher lost are removed
+/// before it runs again.
+const SEED_CLEARING: f64 = 3.0;
+
+/// Run the mesher and check that it kept every boundary triangle; returns the tetrahedra and
+/// the seeds still in place. TetGen's boundary recovery can fail where the front nearly
+/// touches itself and seeds stand close by: then the seeds near the triangle it lost are
+/// removed and it runs again (at most [`SEED_RETRIES`] times, then without any seeds).
+fn fill_keeping_boundary(
+    mesher: &dyn CoreMesher,
+    boundary: &ClosedBoundary,
+    mut guide: CoreGuide,
+) -> Result<(CoreTets, usize), FillError> {
+    let n = boundary.points.len();
+    let mut attempt = 0;
+    loop {
+        let mut tets = mesher.fill(boundary, &guide)?;
+        let seeds_used = merge::interior_points_in_place(boundary, &guide, &tets);
+        merge::drop_unused_points(&mut tets, n);
+        let lost = match merge::check_boundary_kept(boundary, &tets) {
+            Ok(()) => return Ok((tets, seeds_used)),
+            Err(FillError::BoundaryNotKept { triangle, .. }) if !guide.interior.is_empty() => triangle,
+            Err(e) => return Err(e),
+        };
+        let [a, b, c] = boundary.triangles[lost].map(|v| boundary.points[v as usize]);
+        let centre = (a + b + c) / 3.0;
+        let reach = SEED_CLEARING * (a.distance(b) + b.distance(c) + c.distance(a)) / 3.0;
+        let keep: Vec<bool> = if attempt < SEED_RETRIES {
+            guide.interior.iter().map(|p| p.distance(centre) > reach).collect()
+        } else {
+            vec![false; guide.interior.len()]
+        };
+        tracing::info!(
+            triangle = lost,
+            removed = keep.iter().filter(|k| !**k).count(),
+            "the mesher lost a boundary triangle: again without the seeds near it"
+        );
+        let mut kept = keep.iter();
+        guide.interior.retain(|_| *kept.next().unwrap_or(&false));
+        let mut kept = std::iter::repeat(&true).take(n).chain(keep.iter());
+        guide.size.retain(|_| *kept.next().unwrap_or(&false));
+        attempt += 1;
+    }
 }
 
 #[cfg(test)]

@@ -100,6 +100,14 @@ fn collapse_crossing_corner(
     Some(plan.merges.root(v))
 }
 
+/// A face with a column whose extrusion scale exceeds another's by this ratio spans a ridge (a
+/// concave ridge's bisector column has `1/sin(phi/2)`: 1.1 for phi = 130 degrees).
+const RIDGE_SCALE: f64 = 1.1;
+
+/// A wall triangle whose corner stands less than this fraction of its opposite edge's length
+/// over it is a sliver there.
+const SLIVER: f64 = 0.2;
+
 /// Whether roots `v` and `w` may merge: both moving, the front stays a manifold, and they are
 /// not two columns of one fan or columns that slide differently.
 fn can_merge(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, w: u32) -> bool {
@@ -122,14 +130,25 @@ fn crossing_corner(
 ) -> Option<(f64, u32, [u32; 2])> {
     let face = plan.merges.resolved_face(front, f)?;
     let &[a, b, c] = face.nodes() else { return None };
+    // Only along a ridge: a bisector column (a larger extrusion scale) among face columns.
+    let scales = [a, b, c].map(|r| columns.scale[r as usize]);
+    if scales.iter().fold(0.0f64, |m, &s| m.max(s))
+        < RIDGE_SCALE * scales.iter().fold(f64::INFINITY, |m, &s| m.min(s))
+    {
+        return None;
+    }
     let bottom = |r: u32| points[columns.node[r as usize] as usize];
     let top = |r: u32| plan.proposed[r as usize];
     let axis =
         (columns.dir[a as usize] + columns.dir[b as usize] + columns.dir[c as usize]).normalize_or_zero();
+    let wall = |r: u32| columns.base[r as usize];
     let height_ratio = |v: u32, [w0, w1]: [u32; 2]| {
         let at_bottom = corner_height(axis, bottom(v), bottom(w0), bottom(w1));
         let at_top = corner_height(axis, top(v), top(w0), top(w1));
-        if at_bottom > 0.0 {
+        // A sliver on the wall (a long edge with its corner close by) turns over by the least
+        // difference between its columns: that is no meeting of fronts.
+        let sliver = corner_height(axis, wall(v), wall(w0), wall(w1)) < SLIVER * wall(w0).distance(wall(w1));
+        if at_bottom > 0.0 && !sliver {
             at_top / at_bottom
         } else {
             f64::INFINITY
