@@ -183,3 +183,63 @@ fn broken_boundaries_are_errors_not_crashes() {
     let e = crossing.check_no_self_intersection().unwrap_err();
     assert!(matches!(e, FillError::SelfIntersecting { .. }), "{e}");
 }
+
+/// A mesher that loses the boundary while a guide point stands near triangle 0 (as TetGen can
+/// where seeds stand close to a front that nearly touches itself), else fills the single
+/// tetrahedron the boundary is.
+struct LosesTriangleNearSeeds {
+    tet: [u32; 4],
+    always: bool,
+}
+
+impl CoreMesher for LosesTriangleNearSeeds {
+    fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError> {
+        let [a, b, c] = boundary.triangles[0].map(|v| boundary.points[v as usize]);
+        let centre = (a + b + c) / 3.0;
+        let near = guide.interior.iter().any(|p| p.distance(centre) < 1.0);
+        let points = [boundary.points.clone(), guide.interior.clone()].concat();
+        let tets = if near || self.always { Vec::new() } else { vec![self.tet] };
+        Ok(CoreTets { points, tets, boundary_steiner_points: 0 })
+    }
+}
+
+/// The boundary of one tetrahedron, its triangles facing in, and the tetrahedron.
+fn one_tetrahedron(size: f64) -> (ClosedBoundary, [u32; 4]) {
+    let mut points = vec![DVec3::ZERO, DVec3::X * size, DVec3::Y * size, DVec3::Z * size];
+    if orient3d(points[0], points[1], points[2], points[3]) != Sign::Positive {
+        points.swap(1, 2);
+    }
+    let faces = [[0u32, 1, 2], [0, 3, 1], [0, 2, 3], [1, 3, 2]];
+    let inward = |[a, b, c]: [u32; 3]| {
+        let d = (0..4).find(|v| ![a, b, c].contains(v)).unwrap();
+        let p = |v: u32| points[v as usize];
+        if orient3d(p(a), p(b), p(c), p(d)) == Sign::Positive {
+            [a, b, c]
+        } else {
+            [a, c, b]
+        }
+    };
+    let triangles: Vec<[u32; 3]> = faces.into_iter().map(inward).collect();
+    let markers = vec![MARKER_WALL; triangles.len()];
+    (ClosedBoundary { points, triangles, markers }, [0, 1, 2, 3])
+}
+
+#[test]
+fn a_lost_boundary_triangle_is_retried_without_the_seeds_near_it() {
+    let (boundary, tet) = one_tetrahedron(30.0);
+    let [a, b, c] = boundary.triangles[0].map(|v| boundary.points[v as usize]);
+    let seed = (a + b + c) / 3.0 + 0.01 * (DVec3::ONE);
+    let mut guide = CoreGuide::mean_edge_length(&boundary);
+    guide.interior = vec![seed];
+    guide.size.push(1.0);
+    let mesher = LosesTriangleNearSeeds { tet, always: false };
+    let (tets, seeds_used) =
+        fill_keeping_boundary(&mesher, &boundary, guide.clone()).expect("the retry keeps it");
+    assert_eq!((tets.tets.len(), seeds_used, tets.points.len()), (1, 0, 4));
+    // A mesher that loses it whatever the seeds: an error, after the retries.
+    let stubborn = LosesTriangleNearSeeds { tet, always: true };
+    assert!(matches!(
+        fill_keeping_boundary(&stubborn, &boundary, guide),
+        Err(FillError::BoundaryNotKept { triangle: 0, .. })
+    ));
+}
