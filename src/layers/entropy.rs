@@ -82,11 +82,12 @@ pub(super) fn collapse_crushed_edge(
     Some(plan.merges.group(root).collect())
 }
 
-/// Collapse the corner of triangle `f` that is crossing its opposite edge into the nearer end
-/// of that edge, if the front allows it; returns the surviving root. This is a bisector column
-/// overtaking the face columns in front of it along a ridge whose wall edges run obliquely to
-/// it: no edge of the face shrinks much while the face turns over, and the face's bottom may
-/// already be nearly flat (its area says nothing then).
+/// Collapse the corner of invalid triangle `f` that closes in fastest on its opposite edge into
+/// the nearer end of that edge, if the front allows it; returns the surviving root. This is a
+/// bisector column overtaking the face columns in front of it along a ridge whose wall edges
+/// run obliquely to it: no edge of the face shrinks much while the face turns over, and the
+/// face's bottom may already be nearly flat (its area says nothing then). Merging the corner
+/// that closes in, rather than waiting for it to cross, keeps the bisector column moving.
 fn collapse_crossing_corner(
     plan: &mut SlabPlan,
     front: &Front,
@@ -104,6 +105,10 @@ fn collapse_crossing_corner(
 /// concave ridge's bisector column has `1/sin(phi/2)`: 1.1 for phi = 130 degrees).
 const RIDGE_SCALE: f64 = 1.1;
 
+/// A corner whose height over its opposite edge falls below this fraction of what it was, in
+/// one layer, is closing in on it.
+const CLOSING_IN: f64 = 0.5;
+
 /// A wall triangle whose corner stands less than this fraction of its opposite edge's length
 /// over it is a sliver there.
 const SLIVER: f64 = 0.2;
@@ -118,9 +123,10 @@ fn can_merge(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, w: u32) 
 }
 
 /// The corner of triangle `f` (after the merges so far) whose height over its opposite edge
-/// falls most this layer, if it keeps less than [`MEETING_RATIO`] of it: the ratio, the corner
-/// and the ends of its edge, nearer end (at the proposed tops) first. Heights are seen along the
-/// face's mean column direction.
+/// falls most this layer, if below [`CLOSING_IN`] of it: the ratio of its heights after and before, the corner
+/// and the ends of its edge, nearer end (at the proposed tops) first. Heights are seen along
+/// the face's mean column direction. Only a face spanning a ridge, and not a sliver on the
+/// wall, has one.
 fn crossing_corner(
     plan: &SlabPlan,
     front: &Front,
@@ -157,7 +163,7 @@ fn crossing_corner(
     let (ratio, v, mut ends) = [(a, [b, c]), (b, [c, a]), (c, [a, b])]
         .into_iter()
         .map(|(v, e)| (height_ratio(v, e), v, e))
-        .filter(|&(ratio, _, _)| ratio < MEETING_RATIO)
+        .filter(|&(ratio, _, _)| ratio < CLOSING_IN)
         .min_by(|x, y| x.0.total_cmp(&y.0))?;
     let nearer = |w: u32| top(v).distance_squared(top(w));
     ends.sort_by(|x, y| nearer(*x).total_cmp(&nearer(*y)));
