@@ -460,7 +460,7 @@ fn fill_keeping_boundary(
         );
         let mut kept = keep.iter();
         guide.interior.retain(|_| *kept.next().unwrap_or(&false));
-        let mut kept = std::iter::repeat(&true).take(n).chain(keep.iter());
+        let mut kept = std::iter::repeat_n(&true, n).chain(keep.iter());
         guide.size.retain(|_| *kept.next().unwrap_or(&false));
         attempt += 1;
     }

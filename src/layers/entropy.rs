@@ -11,8 +11,9 @@
 //! merged column goes through the middle of their proposals, along their mean direction.
 //!
 //! Where the wall's edges run obliquely to a ridge, a face can turn over with no edge shrinking
-//! much: a corner overtakes its opposite edge (the bisector column passing the face columns in
-//! front of it). Such a face loses that corner instead, merged into the nearer end of the edge.
+//! much: a corner closes in on its opposite edge (the bisector column passing the face columns
+//! in front of it). Such a face loses that corner instead, merged into the nearer end of the
+//! edge.
 
 use glam::DVec3;
 
@@ -95,7 +96,7 @@ fn collapse_crossing_corner(
     columns: &Columns,
     points: &[DVec3],
 ) -> Option<u32> {
-    let (_, v, ends) = crossing_corner(plan, front, f, columns, points)?;
+    let (v, ends) = crossing_corner(plan, front, f, columns, points)?;
     let w = ends.into_iter().find(|&w| can_merge(plan, front, columns, v, w))?;
     collapse(plan, columns, v, w);
     Some(plan.merges.root(v))
@@ -123,17 +124,16 @@ fn can_merge(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, w: u32) 
 }
 
 /// The corner of triangle `f` (after the merges so far) whose height over its opposite edge
-/// falls most this layer, if below [`CLOSING_IN`] of it: the ratio of its heights after and before, the corner
-/// and the ends of its edge, nearer end (at the proposed tops) first. Heights are seen along
-/// the face's mean column direction. Only a face spanning a ridge, and not a sliver on the
-/// wall, has one.
+/// falls most this layer, if below [`CLOSING_IN`] of what it was: the corner and the ends of
+/// its edge, nearer end (at the proposed tops) first. Heights are seen along the face's mean
+/// column direction. Only a face spanning a ridge, and not a sliver on the wall, has one.
 fn crossing_corner(
     plan: &SlabPlan,
     front: &Front,
     f: usize,
     columns: &Columns,
     points: &[DVec3],
-) -> Option<(f64, u32, [u32; 2])> {
+) -> Option<(u32, [u32; 2])> {
     let face = plan.merges.resolved_face(front, f)?;
     let &[a, b, c] = face.nodes() else { return None };
     // Only along a ridge: a bisector column (a larger extrusion scale) among face columns.
@@ -160,14 +160,14 @@ fn crossing_corner(
             f64::INFINITY
         }
     };
-    let (ratio, v, mut ends) = [(a, [b, c]), (b, [c, a]), (c, [a, b])]
+    let (_, v, mut ends) = [(a, [b, c]), (b, [c, a]), (c, [a, b])]
         .into_iter()
         .map(|(v, e)| (height_ratio(v, e), v, e))
         .filter(|&(ratio, _, _)| ratio < CLOSING_IN)
         .min_by(|x, y| x.0.total_cmp(&y.0))?;
     let nearer = |w: u32| top(v).distance_squared(top(w));
     ends.sort_by(|x, y| nearer(*x).total_cmp(&nearer(*y)));
-    Some((ratio, v, ends))
+    Some((v, ends))
 }
 
 /// Signed distance of corner `v` from the line through `a` and `b`, seen along `axis`

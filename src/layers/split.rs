@@ -299,8 +299,8 @@ pub(super) fn propose(
 
 /// The column born at the middle of `edge` in layer `k`: from the middle of the arc between its
 /// ends' wall points (the wall vertex itself for a fan edge), along their mean direction and
-/// scale, its top the middle of theirs pushed along that direction onto the layer's distance. `None` where the
-/// ends slide differently or point opposite ways.
+/// scale, its top the middle of theirs pushed along that direction onto the layer's distance.
+/// `None` where the ends slide differently or point opposite ways.
 fn new_column(
     columns: &Columns,
     proposed: &[DVec3],
