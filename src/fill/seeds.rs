@@ -53,10 +53,20 @@ pub fn seed_points(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]
         .copied()
         .filter(|c| {
             let from = boundary.points[c.vertex as usize];
-            is_clear(&bvh, from, c.point, c.height)
+            let clear = is_clear(&bvh, from, c.point, c.height);
+            if !clear {
+                tracing::trace!(vertex = c.vertex, at = ?c.point, height = c.height, "seed not clear");
+            }
+            clear
         })
         .collect();
     let points = spaced(&clear);
+    tracing::debug!(
+        candidates = candidates.len(),
+        clear = clear.len(),
+        spaced = points.len(),
+        "seeds over the front"
+    );
     Seeds {
         points: points.iter().map(|&i| clear[i].point).collect(),
         vertex: points.iter().map(|&i| clear[i].vertex).collect(),

@@ -181,8 +181,7 @@ fn face_ends(
     }
     for i in 0..n {
         let (a, c) = (cols[i], cols[(i + 1) % n]);
-        if merges.is_merged(a) || merges.is_merged(c) {
-            let from = cut_from(front, merges, columns, a, c);
+        if let Some(from) = lateral_cut(front, merges, columns, a, c) {
             merging.cut |= 1 << i;
             if from == a {
                 merging.cut_from_first |= 1 << i;
@@ -190,6 +189,42 @@ fn face_ends(
         }
     }
     (b, t, n, merging)
+}
+
+/// The column whose bottom node the lateral face over front edge `(a, b)` is cut from, if it is
+/// cut: twisted by a merge ([`cut_from`]), or closing a fan at a ridge end
+/// ([`fan_end_cut_from`]). Both cells beside the face ask this of the same two columns.
+fn lateral_cut(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32) -> Option<u32> {
+    if merges.is_merged(a) || merges.is_merged(b) {
+        return Some(cut_from(front, merges, columns, a, b));
+    }
+
+    fan_end_cut_from(front, columns, a, b)
+}
+
+/// Where a convex ridge ends (its last vertex `w` has one column on it, the vertex `v` before
+/// has a fan of copies), the fan's triangles `(w, v_j, v_j+1)` start from the wall edge
+/// `(w, v)`: over it, the lateral quads `(w, v, V_j, W)` of consecutive fan triangles fold onto
+/// each other along `w W`, and the cell between two of them has no standard shape. Cut from `v`,
+/// the quads' halves `(w, v, W)` cancel and the cell is the tetrahedron `(v, W, V_j, V_j+1)`.
+/// So the face over edge `(a, b)` is cut from `b`'s bottom when a front face on the edge has
+/// another column standing on `b`'s node and none on `a`'s (and the other way round). That
+/// holds only while the fan's copies stand together on the wall, in the first layer.
+fn fan_end_cut_from(front: &Front, columns: &Columns, a: u32, b: u32) -> Option<u32> {
+    let node = |c: u32| columns.node[c as usize];
+    let (lo, hi) = if a < b { (a, b) } else { (b, a) };
+    front.faces_of(lo).find_map(|f| {
+        let cols = front.face_columns(f);
+        if !cols.contains(&hi) {
+            return None;
+        }
+        let shares = |x: u32| cols.iter().any(|&y| y != lo && y != hi && node(y) == node(x));
+        match (shares(lo), shares(hi)) {
+            (true, false) => Some(lo),
+            (false, true) => Some(hi),
+            _ => None,
+        }
+    })
 }
 
 /// Which end of front edge `(a, b)` the twisted lateral face over it is cut from (see
@@ -264,7 +299,11 @@ fn cell_of_face(
     match reshape.swaps.role(f, plan) {
         Some(SwapRole::Absorbed) => return SlabCell::Empty,
         Some(SwapRole::Cell(four)) => {
-            return swap::swap_cell(four.map(|c| columns.node[c as usize]), four.map(&top));
+            let cut = |a: u32, b: u32| {
+                fan_end_cut_from(front, columns, four[a as usize], four[b as usize])
+                    .map(|c| c == four[a as usize])
+            };
+            return swap::swap_cell(four.map(|c| columns.node[c as usize]), four.map(&top), cut);
         }
         None => {}
     }
@@ -594,11 +633,19 @@ fn repair_invalid_cells(
         if changed.is_empty() && changed_faces.is_empty() {
             for &f in &uncollapsed {
                 tracing::debug!(face = f, at = ?wall_points(front, f, columns), "invalid cell: stopping its columns");
-                for &c in front.face_columns(f) {
-                    if plan.moving[plan.merges.root(c) as usize] {
-                        changed.extend(plan.stop(c));
-                    }
+                if tracing::enabled!(tracing::Level::TRACE) {
+                    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+                    let cell = face_cell(front, f, plan, reshape, columns, committed);
+                    let nodes: Vec<(u32, DVec3)> = front
+                        .face_columns(f)
+                        .iter()
+                        .map(|&c| columns.node[c as usize])
+                        .chain(front.face_columns(f).iter().map(|&c| plan.top(c, columns, committed)))
+                        .map(|n| (n, proposal.position(n)))
+                        .collect();
+                    tracing::trace!(?cell, ?nodes, "the invalid cell");
                 }
+                changed.extend(stop_face_columns(plan, front, columns, f));
             }
             uncollapsed.clear();
         }
@@ -614,6 +661,51 @@ fn repair_invalid_cells(
     changed_anywhere.sort_unstable();
     changed_anywhere.dedup();
     changed_anywhere
+}
+
+/// Stop the columns of face `f`; when `f` is a fan face (a strip quad, a ridge end's
+/// triangle), also their fan mates: the other columns from the same wall points, joined to them
+/// by fan edges. A fan cell with one corner stopped and its fan neighbour moving is flat on the
+/// wall and folded above it (its top edges across the fan point opposite ways: a fan step is
+/// narrower than a layer is high), so a partial stop would stop the fans cell by cell along the
+/// whole ridge (the ONERA M6 trailing edge from one cell at its tip, an elbow ridge from one
+/// crushed wall triangle); a whole fan stopped leaves its strips wedges, which stand. A corner
+/// patch on the wall stops alone: there its mates are the corner's every column (wtc2's ledge
+/// corners, whose wall triangles fail in the first layer, would take all their ridges along).
+/// Returns the columns whose cells change.
+fn stop_face_columns(plan: &mut SlabPlan, front: &Front, columns: &Columns, f: usize) -> Vec<u32> {
+    let cols = front.face_columns(f);
+    let n = cols.len();
+    let fan_edge = |i: usize| columns.is_fan_edge(cols[i] as usize, cols[(i + 1) % n] as usize);
+    let corner_on_wall = (0..n).all(fan_edge) && cols.iter().any(|&c| columns.layers[c as usize] == 0);
+    let mut group: Vec<u32> = cols.to_vec();
+    if (0..n).any(fan_edge) && !corner_on_wall {
+        add_fan_mates(front, columns, &mut group);
+    }
+    let mut changed = Vec::new();
+    for c in group {
+        if plan.moving[plan.merges.root(c) as usize] {
+            changed.extend(plan.stop(c));
+        }
+    }
+    changed
+}
+
+/// Add to `group` the fan mates of its columns: the columns joined to them by fan edges.
+fn add_fan_mates(front: &Front, columns: &Columns, group: &mut Vec<u32>) {
+    let mut next = Vec::new();
+    let mut i = 0;
+    while i < group.len() {
+        let c = group[i] as usize;
+        next.clear();
+        front.neighbours(c, &mut next);
+        for &m in &next {
+            if columns.is_fan_edge(c, m) && !group.contains(&(m as u32)) {
+                group.push(m as u32);
+            }
+        }
+        i += 1;
+    }
 }
 
 /// Where face `f`'s columns start on the wall, with their scales (for the debug log).

@@ -190,8 +190,9 @@ fn min_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
 
 /// The cell over a swapped pair with bottom nodes `bottom` and top nodes `top` of `[a, b, c, d]`
 /// (see the module docs); the lateral faces over the outer edges as [`slab::push_lateral`] makes
-/// them for the neighbours (no column of a swap merges, so none is cut).
-pub(super) fn swap_cell(bottom: [u32; 4], top: [u32; 4]) -> SlabCell {
+/// them for the neighbours (no column of a swap merges; `cut(i, j)` says whether the face over
+/// outer edge `(i, j)` is cut, from `i`'s bottom when `Some(true)`, as the neighbour cuts it).
+pub(super) fn swap_cell(bottom: [u32; 4], top: [u32; 4], cut: impl Fn(u32, u32) -> Option<bool>) -> SlabCell {
     let [a, b, c, d] = [0, 1, 2, 3];
     let mut faces = Vec::with_capacity(8);
     for tri in [[a, b, c], [b, a, d]] {
@@ -202,7 +203,7 @@ pub(super) fn swap_cell(bottom: [u32; 4], top: [u32; 4]) -> SlabCell {
         faces.extend(Polygon::dedup(&tri.map(|i| top[i])));
     }
     for (i, j) in [(b, c), (c, a), (a, d), (d, b)] {
-        slab::push_lateral(&mut faces, [bottom[i], bottom[j], top[j], top[i]], None);
+        slab::push_lateral(&mut faces, [bottom[i], bottom[j], top[j], top[i]], cut(i as u32, j as u32));
     }
     slab::remove_opposite_pairs(&mut faces);
     cell_from_faces(faces)
@@ -241,7 +242,7 @@ mod tests {
     #[test]
     fn the_swapped_pair_is_one_cell_closed_by_its_faces() {
         // Bottom nodes 0..4, top nodes 10..14: 2 + 2 triangles and 4 lateral quads.
-        match swap_cell([0, 1, 2, 3], [10, 11, 12, 13]) {
+        match swap_cell([0, 1, 2, 3], [10, 11, 12, 13], |_, _| None) {
             SlabCell::Split { faces, .. } => {
                 assert_eq!(faces.len(), 8);
                 let mut directed: Vec<(u32, u32)> = faces
