@@ -957,11 +957,12 @@ pub struct CoreQuality {
 /// The core's quality bar: no tetrahedron with a dihedral angle below this, degrees.
 pub const SLIVER_THRESHOLD: f64 = 10.0;
 
-/// Improve the mesher's tetrahedra (`core`, filling `boundary`, whose points come first and
-/// stay) and measure them before and after.
+/// Improve the mesher's tetrahedra (`core`, filling `boundary`, whose points come first; they
+/// and the next up to `fixed` stay) and measure them before and after.
 pub fn improve_core(
     boundary: &ClosedBoundary,
     core: CoreTets,
+    fixed: usize,
     options: &ImproveOptions,
 ) -> (CoreTets, CoreQuality) {
     let worst = |points: &[DVec3], tets: &[[u32; 4]]| {
@@ -969,7 +970,7 @@ pub fn improve_core(
     };
     let mesher_min_dihedral = worst(&core.points, &core.tets);
     let mesher_histogram = DihedralHistogram::of(&core.points, &core.tets);
-    let mut mesh = TetMesh::new(core.points, core.tets, boundary.points.len());
+    let mut mesh = TetMesh::new(core.points, core.tets, fixed.max(boundary.points.len()));
     let improvement = mesh.improve(options);
     let (points, tets) = mesh.into_parts();
     let core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };

@@ -56,24 +56,17 @@ pub(super) fn check_boundary_kept(boundary: &ClosedBoundary, core: &CoreTets) ->
     }
 }
 
-/// How many of the guide's interior points are still where they were given, as the points
-/// after the boundary's, and used by a tetrahedron (the mesher may move or drop them: TetGen's
-/// optimisation smooths them like its own).
+/// How many of the guide's interior points, from the first, are still where they were given,
+/// as the points after the boundary's (call after [`drop_unused_points`]: the mesher may move or
+/// drop them, and TetGen's optimisation smooths them like its own; after the first one missing,
+/// the others are out of place).
 pub(super) fn interior_points_in_place(
     boundary: &ClosedBoundary,
     guide: &CoreGuide,
     core: &CoreTets,
 ) -> usize {
     let n = boundary.points.len();
-    let mut used = vec![false; guide.interior.len()];
-    for &v in core.tets.iter().flatten() {
-        if let Some(u) = (v as usize).checked_sub(n).and_then(|i| used.get_mut(i)) {
-            *u = true;
-        }
-    }
-    (0..guide.interior.len())
-        .filter(|&i| used[i] && core.points.get(n + i) == Some(&guide.interior[i]))
-        .count()
+    guide.interior.iter().zip(core.points.get(n..).unwrap_or_default()).take_while(|(g, p)| g == p).count()
 }
 
 /// Drop the points after the first `fixed` that no tetrahedron uses (a mesher may leave an

@@ -201,13 +201,20 @@ impl CoreGuide {
     }
 
     /// [`CoreGuide::mean_edge_length`] and the seeds over the front (`prism_height`: the height
-    /// of the prism under every boundary triangle, see [`seeds::seed_points`]), each sized as
-    /// the front vertex under it.
+    /// of the prism under every boundary triangle, see [`seeds::seed_points`]). A seed and the
+    /// front vertex under it are sized by the larger of the front's edges and the seed's height:
+    /// where the last layer is taller than the front is wide, the first core cell is too, and
+    /// sized by the edges alone the mesher would split it half way up.
     pub fn with_seeds(boundary: &ClosedBoundary, prism_height: &[f64]) -> (CoreGuide, seeds::Seeds) {
         let mut guide = CoreGuide::mean_edge_length(boundary);
         let seeds = seeds::seed_points(boundary, prism_height, &guide.size);
         guide.interior = seeds.points.clone();
-        let seed_sizes: Vec<f64> = seeds.vertex.iter().map(|&v| guide.size[v as usize]).collect();
+        let mut seed_sizes = Vec::with_capacity(seeds.vertex.len());
+        for (&v, &h) in seeds.vertex.iter().zip(&seeds.height) {
+            let size = &mut guide.size[v as usize];
+            *size = size.max(h);
+            seed_sizes.push(*size);
+        }
         guide.size.extend(seed_sizes);
         (guide, seeds)
     }
@@ -405,7 +412,9 @@ pub fn fill_core_with_symmetry(
     let mesher_start = Instant::now();
     let (tets, seeds_used) = fill_keeping_boundary(mesher, &boundary, guide)?;
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
-    let (tets, quality) = improve::improve_core(&boundary, tets, &options.improve);
+    // The seeds stay where they are: they give the first core cells the last layer's height.
+    let fixed = boundary.points.len() + seeds_used;
+    let (tets, quality) = improve::improve_core(&boundary, tets, fixed, &options.improve);
     merge::check_boundary_kept(&boundary, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
     stats.quality = quality;
@@ -438,8 +447,8 @@ fn fill_keeping_boundary(
     let mut attempt = 0;
     loop {
         let mut tets = mesher.fill(boundary, &guide)?;
-        let seeds_used = merge::interior_points_in_place(boundary, &guide, &tets);
         merge::drop_unused_points(&mut tets, n);
+        let seeds_used = merge::interior_points_in_place(boundary, &guide, &tets);
         let lost = match merge::check_boundary_kept(boundary, &tets) {
             Ok(()) => return Ok((tets, seeds_used)),
             Err(FillError::BoundaryNotKept { triangle, .. }) if !guide.interior.is_empty() => triangle,

@@ -21,7 +21,7 @@ use crate::geometry::{triangle_area_vector, Aabb, DVec3};
 const LOWEST_PER_SIZE: f64 = 0.7;
 /// ...and at most this: a tetrahedron much taller than its base is wide is a needle (a last
 /// layer a little taller than the front is wide still gets its match).
-const HIGHEST_PER_SIZE: f64 = 1.3;
+const HIGHEST_PER_SIZE: f64 = 2.0;
 /// Every front triangle at the vertex must face the seed's direction at least this much
 /// (cosine): at a sharper crease of the front the seed would lean over a neighbour.
 const MIN_NORMAL_COSINE: f64 = 0.5;
@@ -36,6 +36,8 @@ pub struct Seeds {
     pub points: Vec<DVec3>,
     /// The front vertex under every seed (a boundary point index).
     pub vertex: Vec<u32>,
+    /// Every seed's height over the front.
+    pub height: Vec<f64>,
     /// Front vertices with a prism under them and a normal their triangles face (the
     /// candidates).
     pub candidates: usize,
@@ -70,6 +72,7 @@ pub fn seed_points(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]
     Seeds {
         points: points.iter().map(|&i| clear[i].point).collect(),
         vertex: points.iter().map(|&i| clear[i].vertex).collect(),
+        height: points.iter().map(|&i| clear[i].height).collect(),
         candidates: candidates.len(),
     }
 }
