@@ -497,6 +497,17 @@ fn web_patch(v: u32, polygon: &[u32], patch: u32, fan_angle: f64, out: &mut Wall
         out.stats.fan_columns += 1;
         out.columns.len() as u32 - 1
     };
+    if !star_shaped(centre_dir, &dirs) {
+        // Rings around the centre would turn over where the polygon folds back (a corner of
+        // three ridges on a coarse, irregular wall): its own columns, ear by ear, instead.
+        if let Some(triangles) = ear_triangles(centre_dir, &dirs) {
+            tracing::debug!(vertex = v, columns = dirs.len(), "corner patch cut into ears");
+            for [a, b, c] in triangles {
+                out.fan_faces.push(FanFace::new(&[polygon[a], polygon[b], polygon[c]], patch));
+            }
+            return;
+        }
+    }
     let centre = new_column(centre_dir, out);
     // ring[l][i]: l = 1..rings-1 inner rings, the polygon itself is ring `rings`.
     let mut previous: Vec<u32> = Vec::new();
@@ -518,6 +529,56 @@ fn web_patch(v: u32, polygon: &[u32], patch: u32, fan_angle: f64, out: &mut Wall
         }
         previous = ring;
     }
+}
+
+/// Whether every triangle `(centre, d_i, d_i+1)` of the polygon of directions `dirs` turns the
+/// front's way (seen from outside the unit sphere): its first cells, cones from the wall point,
+/// then have positive volumes.
+fn star_shaped(centre: DVec3, dirs: &[DVec3]) -> bool {
+    let n = dirs.len();
+    (0..n).all(|i| centre.dot(dirs[i].cross(dirs[(i + 1) % n])) > 0.0)
+}
+
+/// A triangulation of the polygon of directions `dirs` (the front's way round) by ear clipping,
+/// seen through the tangent plane at `centre` (a direction's point there is `d / (d . centre)`):
+/// triangles of polygon indices, or `None` when some direction is not in front of the plane or
+/// no ear is left (the polygon crosses itself there).
+fn ear_triangles(centre: DVec3, dirs: &[DVec3]) -> Option<Vec<[usize; 3]>> {
+    if dirs.iter().any(|d| d.dot(centre) <= 1e-6) {
+        return None;
+    }
+    let x_axis = centre.any_orthonormal_vector();
+    let y_axis = centre.cross(x_axis);
+    let plane: Vec<[f64; 2]> = dirs
+        .iter()
+        .map(|&d| {
+            let p = d / d.dot(centre);
+            [p.dot(x_axis), p.dot(y_axis)]
+        })
+        .collect();
+    let turn =
+        |a: [f64; 2], b: [f64; 2], c: [f64; 2]| (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    let mut left: Vec<usize> = (0..dirs.len()).collect();
+    let mut triangles = Vec::with_capacity(dirs.len().saturating_sub(2));
+    while left.len() > 3 {
+        let n = left.len();
+        let ear = (0..n).find(|&i| {
+            let (a, b, c) = (left[(i + n - 1) % n], left[i], left[(i + 1) % n]);
+            turn(plane[a], plane[b], plane[c]) > 0.0
+                && left.iter().filter(|&&q| q != a && q != b && q != c).all(|&q| {
+                    let p = plane[q];
+                    turn(plane[a], plane[b], p) < 0.0
+                        || turn(plane[b], plane[c], p) < 0.0
+                        || turn(plane[c], plane[a], p) < 0.0
+                })
+        })?;
+        triangles.push([left[(ear + n - 1) % n], left[ear], left[(ear + 1) % n]]);
+        left.remove(ear);
+    }
+    let [a, b, c] = [left[0], left[1], left[2]];
+    (turn(plane[a], plane[b], plane[c]) > 0.0).then_some(())?;
+    triangles.push([a, b, c]);
+    Some(triangles)
 }
 
 #[cfg(test)]
@@ -620,6 +681,31 @@ mod closed_front_tests {
 #[cfg(test)]
 mod ridge_fan_tests {
     use super::*;
+
+    #[test]
+    fn a_corner_polygon_folding_back_is_cut_into_ears_that_face_the_fluid() {
+        // A simple polygon, counter-clockwise seen from +z, whose edges (-2, 1) -> (1, 1) -> (1, -1)
+        // turn clockwise around the centre: rings around it would turn over there.
+        let plane = [(2.0, -1.0), (2.0, 2.0), (-2.0, 2.0), (-2.0, 1.0), (1.0, 1.0), (1.0, -1.0)];
+        let dirs: Vec<DVec3> = plane.iter().map(|&(x, y)| DVec3::new(x, y, 1.0).normalize()).collect();
+        assert!(!star_shaped(DVec3::Z, &dirs));
+        let ears = ear_triangles(DVec3::Z, &dirs).expect("a simple polygon has ears");
+        assert_eq!(ears.len(), plane.len() - 2);
+        let mut area = 0.0;
+        for [a, b, c] in ears {
+            // The first cells of a corner patch are cones from the wall point: positive volumes.
+            assert!(dirs[a].dot(dirs[b].cross(dirs[c])) > 0.0, "{a} {b} {c}");
+            let (p, q, r) = (plane[a], plane[b], plane[c]);
+            area += 0.5 * ((q.0 - p.0) * (r.1 - p.1) - (q.1 - p.1) * (r.0 - p.0));
+        }
+        assert!((area - 6.0).abs() < 1e-12, "the ears cover the polygon once: area {area}");
+        // A polygon crossing itself has no ear left at some point.
+        let bow: Vec<DVec3> = [(1.0, 1.0), (-1.0, -1.0), (1.0, -1.0), (-1.0, 1.0)]
+            .iter()
+            .map(|&(x, y)| DVec3::new(x, y, 1.0).normalize())
+            .collect();
+        assert!(ear_triangles(DVec3::Z, &bow).is_none());
+    }
 
     #[test]
     fn saddle_fan_columns_meet_both_cylinders() {
