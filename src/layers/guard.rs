@@ -153,6 +153,10 @@ impl CrossingGuard {
         }
         let shapes: Vec<TopShape> = needed.par_iter().map(|&f| top.shape(f)).collect();
         let shape = |f: u32| &shapes[shape_of[f as usize] as usize];
+        if tracing::enabled!(tracing::Level::TRACE) {
+            let crossing = tested.iter().copied().filter(|&(f, g)| shape(f).crosses(shape(g)));
+            trace_crossing_pairs(front, columns, crossing);
+        }
         let mut faces: Vec<usize> = tested
             .par_iter()
             .filter(|&&(f, g)| shape(f).crosses(shape(g)))
@@ -163,6 +167,19 @@ impl CrossingGuard {
         faces.sort_unstable();
         faces.dedup();
         faces
+    }
+}
+
+/// Log every crossing pair with how near the two faces are on the front (columns shared; a
+/// column of one next to or from the same wall vertex as one of the other): far apart, they are
+/// fronts meeting across a gap or a fold, not a local collapse.
+fn trace_crossing_pairs(front: &Front, columns: &Columns, pairs: impl Iterator<Item = (u32, u32)>) {
+    for (f, g) in pairs {
+        let (a, b) = (front.face_columns(f as usize), front.face_columns(g as usize));
+        let shared = a.iter().filter(|c| b.contains(c)).count();
+        let wall = |c: u32| columns.wall_vertex[c as usize];
+        let near = a.iter().any(|&x| b.iter().any(|&y| front.are_neighbours(x, y) || wall(x) == wall(y)));
+        tracing::trace!(f, g, shared, near, "crossing pair");
     }
 }
 
