@@ -17,18 +17,21 @@ use crate::geometry::{triangle_area_vector, Aabb, DVec3};
 
 /// A seed's height over its vertex in the local front size (mean boundary edge length there):
 /// at least this, so that a thin last layer does not make flat tetrahedra (the jump is then the
-/// layers', which end too thin for isotropic cells)...
-const LOWEST_PER_SIZE: f64 = 0.7;
+/// layers', which end too thin for isotropic cells; a tetrahedron half as high as its base is
+/// wide still has dihedral angles of 30 degrees and more)...
+const LOWEST_PER_SIZE: f64 = 0.5;
 /// ...and at most this: a tetrahedron much taller than its base is wide is a needle (a last
-/// layer a little taller than the front is wide still gets its match).
+/// layer up to twice as tall as the front is wide still gets its match).
 const HIGHEST_PER_SIZE: f64 = 2.0;
 /// Every front triangle at the vertex must face the seed's direction at least this much
 /// (cosine): at a sharper crease of the front the seed would lean over a neighbour.
 const MIN_NORMAL_COSINE: f64 = 0.5;
 /// Smallest distance from a seed to the boundary, in seed heights (a flat front gives 1).
 const CLEARANCE: f64 = 0.7;
-/// Smallest distance between two seeds, in the smaller of their heights.
-const SPACING: f64 = 0.5;
+/// Smallest distance between two seeds, in the smaller of their heights: enough to keep
+/// seeds of two fronts facing each other, or of a front folding, off each other (at 0.5, 10% of
+/// the ONERA M6's candidates were thinned out where its stretched triangles are narrow).
+const SPACING: f64 = 0.35;
 
 /// Seeds and what became of the candidates.
 #[derive(Clone, Debug, Default)]
@@ -269,9 +272,9 @@ mod tests {
     #[test]
     fn seeds_too_close_to_each_other_are_thinned_lowest_first() {
         let c = |x: f64, h: f64, v: u32| Candidate { vertex: v, point: DVec3::new(x, 0.0, 0.0), height: h };
-        // 0 and 1 are 0.4 apart (under SPACING of the smaller height 1): the lower, 1, wins; 2
+        // 0 and 1 are 0.3 apart (under SPACING of the smaller height 1): the lower, 1, wins; 2
         // is far.
-        let kept = spaced(&[c(0.0, 1.2, 0), c(0.4, 1.0, 1), c(3.0, 1.0, 2)]);
+        let kept = spaced(&[c(0.0, 1.2, 0), c(0.3, 1.0, 1), c(3.0, 1.0, 2)]);
         assert_eq!(kept, vec![1, 2]);
     }
 }
