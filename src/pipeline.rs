@@ -211,11 +211,12 @@ pub fn run(
     };
     let layer_summary = layer_summary(&layered, &surface, &topology, &features);
     let (mesh, core) = if options.core {
+        let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
         let (mesh, mut stats) = timings.time("core", || {
-            let options = CoreOptions::from_config(config);
+            let mut options = CoreOptions::from_config(config);
+            options.improve.size_band = growth;
             fill_core_on_symmetry_plane(&layered.mesh, &closed.core_wall, &options, symmetry)
         })?;
-        let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
         let core_zone = mesh.zone_names.iter().position(|z| z == crate::fill::CORE_ZONE_NAME);
         if let Some(core_zone) = core_zone {
             stats.size_jump = crate::fill::size_jump::measure(

@@ -79,11 +79,19 @@ pub struct ImproveOptions {
     pub passes: usize,
     /// Insert points on interior edges when flips and smoothing do not help.
     pub insert_points: bool,
+    /// No change may take more first core tetrahedra out of [1/size_band, size_band] of the
+    /// last layer under them (their height over the front triangle; the growth ratio).
+    pub size_band: f64,
 }
 
 impl Default for ImproveOptions {
     fn default() -> Self {
-        ImproveOptions { target_dihedral: 12.0, passes: 20, insert_points: true }
+        ImproveOptions {
+            target_dihedral: 12.0,
+            passes: 20,
+            insert_points: true,
+            size_band: crate::config::DEFAULT_GROWTH,
+        }
     }
 }
 
@@ -161,6 +169,10 @@ pub struct TetMesh {
     ball: Vec<Vec<u32>>,
     /// Points below this index are on the boundary: they never move.
     fixed: usize,
+    /// The last layer's height under every front triangle with a prism under it, and the band
+    /// the first core tetrahedron's height over it is kept in ([`TetMesh::keep_front_match`]).
+    front_height: HashMap<[u32; 3], f64>,
+    band: f64,
 }
 
 impl TetMesh {
@@ -173,7 +185,40 @@ impl TetMesh {
             }
         }
         let alive = vec![true; tets.len()];
-        TetMesh { points, tets, alive, ball, fixed }
+        TetMesh { points, tets, alive, ball, fixed, front_height: HashMap::new(), band: f64::INFINITY }
+    }
+
+    /// Refuse every change that leaves more tetrahedra on the front triangles of
+    /// `front_height` (sorted nodes, last layer height) with a height over their triangle out
+    /// of [1/band, band] of it, unless it mends a sliver (below [`SLIVER_THRESHOLD`]): the
+    /// seeds gave the first core cells the last layer's height, and a flip or an insertion
+    /// near the front would take it away.
+    pub fn keep_front_match(&mut self, front_height: HashMap<[u32; 3], f64>, band: f64) {
+        self.front_height = front_height;
+        self.band = band;
+    }
+
+    /// How many front triangles of `tet` (with point `moved` at its new place) have it out of
+    /// the band of their last layer.
+    fn front_mismatches(&self, tet: [u32; 4], moved: Option<(u32, DVec3)>) -> usize {
+        if self.front_height.is_empty() {
+            return 0;
+        }
+        let x = |v: u32| match moved {
+            Some((m, p)) if m == v => p,
+            _ => self.points[v as usize],
+        };
+        (0..4)
+            .filter(|&apex| {
+                let mut key = [tet[(apex + 1) % 4], tet[(apex + 2) % 4], tet[(apex + 3) % 4]];
+                key.sort_unstable();
+                self.front_height.get(&key).is_some_and(|&h| {
+                    let normal = triangle_area_vector(x(key[0]), x(key[1]), x(key[2])).normalize_or_zero();
+                    let ratio = (x(tet[apex]) - x(key[0])).dot(normal).abs() / h;
+                    !(1.0 / self.band..=self.band).contains(&ratio)
+                })
+            })
+            .count()
     }
 
     /// The live tetrahedra.
@@ -262,6 +307,17 @@ impl TetMesh {
             None => add.iter().map(|&t| self.quality(t)).collect(),
         };
         let change = Change::from_qualities(remove, add, point, &old, &new);
+        // A sliver may be mended at the cost of a first core cell's match, nothing less.
+        if change.before >= SLIVER_THRESHOLD && !self.front_height.is_empty() {
+            let mismatches = |tets: &mut dyn Iterator<Item = ([u32; 4], Option<(u32, DVec3)>)>| -> usize {
+                tets.map(|(t, moved)| self.front_mismatches(t, moved)).sum()
+            };
+            let before = mismatches(&mut change.remove.iter().map(|&t| (self.tets[t as usize], None)));
+            let after = mismatches(&mut change.add.iter().map(|&t| (t, change.point)));
+            if after > before {
+                return None;
+            }
+        }
         (change.after > INVALID).then_some(change)
     }
 
@@ -958,11 +1014,14 @@ pub struct CoreQuality {
 pub const SLIVER_THRESHOLD: f64 = 10.0;
 
 /// Improve the mesher's tetrahedra (`core`, filling `boundary`, whose points come first; they
-/// and the next up to `fixed` stay) and measure them before and after.
+/// and the next up to `fixed` stay) and measure them before and after. `prism_height` is the
+/// last layer's height under every boundary triangle (NaN where none): the first core
+/// tetrahedra on them keep their match ([`TetMesh::keep_front_match`]).
 pub fn improve_core(
     boundary: &ClosedBoundary,
     core: CoreTets,
     fixed: usize,
+    prism_height: &[f64],
     options: &ImproveOptions,
 ) -> (CoreTets, CoreQuality) {
     let worst = |points: &[DVec3], tets: &[[u32; 4]]| {
@@ -971,6 +1030,14 @@ pub fn improve_core(
     let mesher_min_dihedral = worst(&core.points, &core.tets);
     let mesher_histogram = DihedralHistogram::of(&core.points, &core.tets);
     let mut mesh = TetMesh::new(core.points, core.tets, fixed.max(boundary.points.len()));
+    let front_height = boundary
+        .triangles
+        .iter()
+        .zip(prism_height)
+        .filter(|(_, h)| h.is_finite() && **h > 0.0)
+        .map(|(&t, &h)| (sorted_triangle(t), h))
+        .collect();
+    mesh.keep_front_match(front_height, options.size_band);
     let improvement = mesh.improve(options);
     let (points, tets) = mesh.into_parts();
     let core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };

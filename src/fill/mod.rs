@@ -404,8 +404,9 @@ pub fn fill_core_with_symmetry(
         (None, None) => {}
     }
     let (boundary, nodes) = core.closed_boundary();
+    let prism_heights = core.prism_heights();
     let (guide, seeds) = if options.seed_front {
-        CoreGuide::with_seeds(&boundary, &core.prism_heights())
+        CoreGuide::with_seeds(&boundary, &prism_heights)
     } else {
         (CoreGuide::mean_edge_length(&boundary), seeds::Seeds::default())
     };
@@ -414,7 +415,7 @@ pub fn fill_core_with_symmetry(
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     // The seeds stay where they are: they give the first core cells the last layer's height.
     let fixed = boundary.points.len() + seeds_used;
-    let (tets, quality) = improve::improve_core(&boundary, tets, fixed, &options.improve);
+    let (tets, quality) = improve::improve_core(&boundary, tets, fixed, &prism_heights, &options.improve);
     merge::check_boundary_kept(&boundary, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
     stats.quality = quality;

@@ -238,3 +238,20 @@ proptest! {
         prop_assert!(mesh.worst(mesh.tets()) >= before);
     }
 }
+
+/// The first core tetrahedron on a front triangle keeps the last layer's height: lowering its
+/// apex to the regular tetrahedron's height is a gain in angles, refused once it takes the cell
+/// out of [1/r, r] of the layer under it, allowed within.
+#[test]
+fn no_change_takes_a_first_core_cell_off_the_last_layer_height() {
+    let s = 3f64.sqrt();
+    let apex = |z: f64| DVec3::new(0.5, s / 6.0, z);
+    let points = vec![DVec3::ZERO, DVec3::X, DVec3::new(0.5, s / 2.0, 0.0), apex(1.0)];
+    assert!(tet_signed_volume(points[0], points[1], points[2], points[3]) > 0.0);
+    let mut mesh = TetMesh::new(points, vec![[0, 1, 2, 3]], 3);
+    let lower = |mesh: &TetMesh, z: f64| mesh.change(vec![0], vec![[0, 1, 2, 3]], Some((3, apex(z))));
+    assert!(lower(&mesh, 0.82).is_some_and(|c| c.after > c.before + 1.0), "a plain gain without the layer");
+    mesh.keep_front_match(HashMap::from([([0, 1, 2], 1.0)]), 1.2);
+    assert!(lower(&mesh, 0.82).is_none(), "0.82 is below 1/1.2 of the layer");
+    assert!(lower(&mesh, 0.9).is_some(), "0.9 is within the band");
+}
