@@ -539,6 +539,15 @@ fn star_shaped(centre: DVec3, dirs: &[DVec3]) -> bool {
     (0..n).all(|i| centre.dot(dirs[i].cross(dirs[(i + 1) % n])) > 0.0)
 }
 
+/// The smallest angle of the plane triangle `(a, b, c)`, radians.
+fn min_angle_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let angle = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
+        let (u, v) = ([q[0] - p[0], q[1] - p[1]], [r[0] - p[0], r[1] - p[1]]);
+        (u[0] * v[1] - u[1] * v[0]).abs().atan2(u[0] * v[0] + u[1] * v[1])
+    };
+    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
+}
+
 /// A triangulation of the polygon of directions `dirs` (the front's way round) by ear clipping,
 /// seen through the tangent plane at `centre` (a direction's point there is `d / (d . centre)`):
 /// triangles of polygon indices, or `None` when some direction is not in front of the plane or
@@ -562,8 +571,9 @@ fn ear_triangles(centre: DVec3, dirs: &[DVec3]) -> Option<Vec<[usize; 3]>> {
     let mut triangles = Vec::with_capacity(dirs.len().saturating_sub(2));
     while left.len() > 3 {
         let n = left.len();
-        let ear = (0..n).find(|&i| {
-            let (a, b, c) = (left[(i + n - 1) % n], left[i], left[(i + 1) % n]);
+        let corners = |i: usize| (left[(i + n - 1) % n], left[i], left[(i + 1) % n]);
+        let ear = (0..n).filter(|&i| {
+            let (a, b, c) = corners(i);
             turn(plane[a], plane[b], plane[c]) > 0.0
                 && left.iter().filter(|&&q| q != a && q != b && q != c).all(|&q| {
                     let p = plane[q];
@@ -571,6 +581,14 @@ fn ear_triangles(centre: DVec3, dirs: &[DVec3]) -> Option<Vec<[usize; 3]>> {
                         || turn(plane[b], plane[c], p) < 0.0
                         || turn(plane[c], plane[a], p) < 0.0
                 })
+        });
+        // The best shaped ear first: the front over the patch is made of these triangles.
+        let ear = ear.max_by(|&i, &j| {
+            let shape = |i: usize| {
+                let (a, b, c) = corners(i);
+                min_angle_2d(plane[a], plane[b], plane[c])
+            };
+            shape(i).total_cmp(&shape(j))
         })?;
         triangles.push([left[(ear + n - 1) % n], left[ear], left[(ear + 1) % n]]);
         left.remove(ear);
