@@ -342,3 +342,28 @@ fn auto_layers_on_a_sphere_end_without_a_size_jump() {
     assert!(jump.within_band >= 0.85, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
     assert!((0.9..1.15).contains(&jump.median), "median {}", jump.median);
 }
+
+/// Issue 5's bars with the defaults (h0 = 1e-3 D, 10 layers and transition layers to isotropy)
+/// on the shipped examples: the first core tetrahedron on a front triangle is within [1/r, r]
+/// of the last layer under it at 95% of the front triangles on the sphere (97.3% measured), and
+/// the core has no dihedral angle below 10 degrees. The box reaches 92.1%: where stacks end one
+/// layer apart, the lower step's core cell reaches the upper step's front node.
+#[test]
+fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
+    for (name, within) in [("sphere.stl", 0.95), ("box.stl", 0.9)] {
+        let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
+        let surface = blmesh::io::read_surface(Path::new(&path)).expect("the example reads");
+        let out = run(surface, &Config::default(), &MeshOptions { core: true }, Progress::hidden())
+            .expect("the example meshes");
+        assert!(out.report.check.is_valid(), "{name}: {}", out.report.check);
+        let core = out.report.core.as_ref().expect("a core");
+        let jump = &core.size_jump.stats;
+        eprintln!("{name}: size jump {jump:?}, core min dihedral {:.2}", core.quality.min_dihedral);
+        assert!(jump.within_band >= within, "{name}: {:.1}% within [1/r, r]", 100.0 * jump.within_band);
+        assert!(
+            core.quality.min_dihedral >= 10.0,
+            "{name}: core min dihedral {:.2}",
+            core.quality.min_dihedral
+        );
+    }
+}
