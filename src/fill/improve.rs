@@ -201,9 +201,6 @@ impl TetMesh {
     /// How many front triangles of `tet` (with point `moved` at its new place) have it out of
     /// the band of their last layer.
     fn front_mismatches(&self, tet: [u32; 4], moved: Option<(u32, DVec3)>) -> usize {
-        if self.front_height.is_empty() {
-            return 0;
-        }
         let x = |v: u32| match moved {
             Some((m, p)) if m == v => p,
             _ => self.points[v as usize],
@@ -309,11 +306,9 @@ impl TetMesh {
         let change = Change::from_qualities(remove, add, point, &old, &new);
         // A sliver may be mended at the cost of a first core cell's match, nothing less.
         if change.before >= SLIVER_THRESHOLD && !self.front_height.is_empty() {
-            let mismatches = |tets: &mut dyn Iterator<Item = ([u32; 4], Option<(u32, DVec3)>)>| -> usize {
-                tets.map(|(t, moved)| self.front_mismatches(t, moved)).sum()
-            };
-            let before = mismatches(&mut change.remove.iter().map(|&t| (self.tets[t as usize], None)));
-            let after = mismatches(&mut change.add.iter().map(|&t| (t, change.point)));
+            let before: usize =
+                change.remove.iter().map(|&t| self.front_mismatches(self.tets[t as usize], None)).sum();
+            let after: usize = change.add.iter().map(|&t| self.front_mismatches(t, change.point)).sum();
             if after > before {
                 return None;
             }

@@ -55,6 +55,12 @@ pub fn triangle_area_vector(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     (b - a).cross(c - a)
 }
 
+/// The smallest corner angle of triangle (a, b, c), in degrees.
+pub fn triangle_min_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    let corner = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p).to_degrees();
+    corner(a, b, c).min(corner(b, c, a)).min(corner(c, a, b))
+}
+
 /// Signed volume of tetrahedron (a, b, c, d): positive when d lies on the side the right-hand
 /// normal of (a, b, c) points to (the Gmsh/VTK convention for a valid tetrahedron).
 pub fn tet_signed_volume(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {

@@ -146,6 +146,18 @@ impl SlabPlan {
         }
     }
 
+    /// Stop the groups of those of `columns` still moving ([`SlabPlan::stop`]); returns the
+    /// columns whose cells change.
+    fn stop_all(&mut self, columns: impl IntoIterator<Item = u32>) -> Vec<u32> {
+        let mut changed = Vec::new();
+        for c in columns {
+            if self.moving[self.merges.root(c) as usize] {
+                changed.extend(self.stop(c));
+            }
+        }
+        changed
+    }
+
     /// Stop the group of `c`'s root: the root and every column merged into it keep their node.
     /// Returns the columns whose cells change.
     fn stop(&mut self, c: u32) -> Vec<u32> {
@@ -198,7 +210,6 @@ fn lateral_cut(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32
     if merges.is_merged(a) || merges.is_merged(b) {
         return Some(cut_from(front, merges, columns, a, b));
     }
-
     fan_end_cut_from(front, columns, a, b)
 }
 
@@ -576,11 +587,7 @@ fn settle_slab(
         let mut changed = Vec::new();
         for f in crossing {
             tracing::debug!(face = f, at = ?wall_points(front, f, columns), "the new front crosses itself: stopping the face's columns");
-            for &c in front.face_columns(f) {
-                if plan.moving[plan.merges.root(c) as usize] {
-                    changed.extend(plan.stop(c));
-                }
-            }
+            changed.extend(plan.stop_all(front.face_columns(f).iter().copied()));
         }
         if changed.is_empty() {
             return plan;
@@ -634,16 +641,7 @@ fn repair_invalid_cells(
             for &f in &uncollapsed {
                 tracing::debug!(face = f, at = ?wall_points(front, f, columns), "invalid cell: stopping its columns");
                 if tracing::enabled!(tracing::Level::TRACE) {
-                    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-                    let cell = face_cell(front, f, plan, reshape, columns, committed);
-                    let nodes: Vec<(u32, DVec3)> = front
-                        .face_columns(f)
-                        .iter()
-                        .map(|&c| columns.node[c as usize])
-                        .chain(front.face_columns(f).iter().map(|&c| plan.top(c, columns, committed)))
-                        .map(|n| (n, proposal.position(n)))
-                        .collect();
-                    tracing::trace!(?cell, ?nodes, "the invalid cell");
+                    trace_invalid_cell(plan, reshape, mesh, columns, front, f);
                 }
                 changed.extend(stop_face_columns(plan, front, columns, f));
             }
@@ -682,13 +680,7 @@ fn stop_face_columns(plan: &mut SlabPlan, front: &Front, columns: &Columns, f: u
     if (0..n).any(fan_edge) && !corner_on_wall {
         add_fan_mates(front, columns, &mut group);
     }
-    let mut changed = Vec::new();
-    for c in group {
-        if plan.moving[plan.merges.root(c) as usize] {
-            changed.extend(plan.stop(c));
-        }
-    }
-    changed
+    plan.stop_all(group)
 }
 
 /// Add to `group` the fan mates of its columns: the columns joined to them by fan edges.
@@ -706,6 +698,29 @@ fn add_fan_mates(front: &Front, columns: &Columns, group: &mut Vec<u32>) {
         }
         i += 1;
     }
+}
+
+/// Log the invalid cell over face `f`: its shape and its bottom and top nodes with their
+/// positions.
+fn trace_invalid_cell(
+    plan: &SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    f: usize,
+) {
+    let committed = mesh.points.len() as u32;
+    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    let cell = face_cell(front, f, plan, reshape, columns, committed);
+    let cols = front.face_columns(f);
+    let nodes: Vec<(u32, DVec3)> = cols
+        .iter()
+        .map(|&c| columns.node[c as usize])
+        .chain(cols.iter().map(|&c| plan.top(c, columns, committed)))
+        .map(|n| (n, proposal.position(n)))
+        .collect();
+    tracing::trace!(?cell, ?nodes, "the invalid cell");
 }
 
 /// Where face `f`'s columns start on the wall, with their scales (for the debug log).

@@ -16,6 +16,7 @@ use super::front::{Columns, Front};
 use super::march::SlabPlan;
 use super::slab::{self, cell_from_faces, Polygon, SlabCell};
 use super::split::Splits;
+use crate::geometry::triangle_min_angle;
 
 /// A pair is swapped only when its worst angle is below this (degrees)...
 const POOR_ANGLE: f64 = 30.0;
@@ -106,7 +107,7 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
         // A pair gains only when one of its triangles is poor: most faces stop here (a pair
         // is looked at from its poor face, so from both when both are).
         let [p, q, r] = [0, 1, 2].map(|i| proposed[cols[i] as usize]);
-        if min_angle(p, q, r) >= POOR_ANGLE {
+        if triangle_min_angle(p, q, r) >= POOR_ANGLE {
             continue;
         }
         for i in 0..3 {
@@ -171,21 +172,15 @@ fn opposite_face(front: &Front, f: usize, a: u32, b: u32) -> Option<usize> {
 /// swapping to `(c, a, d)`, `(d, b, c)` is worth it (the worst is poor, rises by [`GAIN`], and
 /// the new triangles face the old pair's way), else `None`.
 fn gain([a, b, c, d]: [DVec3; 4]) -> Option<f64> {
-    let old = min_angle(a, b, c).min(min_angle(b, a, d));
+    let old = triangle_min_angle(a, b, c).min(triangle_min_angle(b, a, d));
     if old >= POOR_ANGLE {
         return None;
     }
-    let new = min_angle(c, a, d).min(min_angle(d, b, c));
+    let new = triangle_min_angle(c, a, d).min(triangle_min_angle(d, b, c));
     let normal = (b - a).cross(c - a) + (a - b).cross(d - b);
     let (n1, n2) = ((a - c).cross(d - c), (b - d).cross(c - d));
     let facing = n1.dot(normal) > 0.0 && n2.dot(normal) > 0.0 && n1.dot(n2) > 0.5 * n1.length() * n2.length();
     (facing && new > GAIN * old).then_some(old)
-}
-
-/// The smallest angle of triangle `(a, b, c)`, in degrees.
-fn min_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let angle = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p).to_degrees();
-    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
 }
 
 /// The cell over a swapped pair with bottom nodes `bottom` and top nodes `top` of `[a, b, c, d]`

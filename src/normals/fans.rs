@@ -18,6 +18,8 @@
 use glam::DVec3;
 
 use super::most_normal::most_normal;
+use crate::geometry::predicates::{orient2d, Sign};
+use crate::geometry::triangle_min_angle;
 use crate::layers::slab::Polygon;
 use crate::surface::features::{EdgeKind, Features};
 use crate::surface::topology::Topology;
@@ -539,15 +541,6 @@ fn star_shaped(centre: DVec3, dirs: &[DVec3]) -> bool {
     (0..n).all(|i| centre.dot(dirs[i].cross(dirs[(i + 1) % n])) > 0.0)
 }
 
-/// The smallest angle of the plane triangle `(a, b, c)`, radians.
-fn min_angle_2d(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
-    let angle = |p: [f64; 2], q: [f64; 2], r: [f64; 2]| {
-        let (u, v) = ([q[0] - p[0], q[1] - p[1]], [r[0] - p[0], r[1] - p[1]]);
-        (u[0] * v[1] - u[1] * v[0]).abs().atan2(u[0] * v[0] + u[1] * v[1])
-    };
-    angle(a, b, c).min(angle(b, c, a)).min(angle(c, a, b))
-}
-
 /// A triangulation of the polygon of directions `dirs` (the front's way round) by ear clipping,
 /// seen through the tangent plane at `centre` (a direction's point there is `d / (d . centre)`):
 /// triangles of polygon indices, or `None` when some direction is not in front of the plane or
@@ -556,45 +549,43 @@ fn ear_triangles(centre: DVec3, dirs: &[DVec3]) -> Option<Vec<[usize; 3]>> {
     if dirs.iter().any(|d| d.dot(centre) <= 1e-6) {
         return None;
     }
+    // Every direction's point on the tangent plane, in coordinates of the plane (z = 0).
     let x_axis = centre.any_orthonormal_vector();
     let y_axis = centre.cross(x_axis);
-    let plane: Vec<[f64; 2]> = dirs
+    let plane: Vec<DVec3> = dirs
         .iter()
         .map(|&d| {
             let p = d / d.dot(centre);
-            [p.dot(x_axis), p.dot(y_axis)]
+            DVec3::new(p.dot(x_axis), p.dot(y_axis), 0.0)
         })
         .collect();
-    let turn =
-        |a: [f64; 2], b: [f64; 2], c: [f64; 2]| (b[0] - a[0]) * (c[1] - a[1]) - (b[1] - a[1]) * (c[0] - a[0]);
+    let xy = |i: usize| [plane[i].x, plane[i].y];
+    let turn = |a: usize, b: usize, c: usize| orient2d(xy(a), xy(b), xy(c));
     let mut left: Vec<usize> = (0..dirs.len()).collect();
     let mut triangles = Vec::with_capacity(dirs.len().saturating_sub(2));
     while left.len() > 3 {
         let n = left.len();
         let corners = |i: usize| (left[(i + n - 1) % n], left[i], left[(i + 1) % n]);
-        let ear = (0..n).filter(|&i| {
+        let ears = (0..n).filter(|&i| {
             let (a, b, c) = corners(i);
-            turn(plane[a], plane[b], plane[c]) > 0.0
+            turn(a, b, c) == Sign::Positive
                 && left.iter().filter(|&&q| q != a && q != b && q != c).all(|&q| {
-                    let p = plane[q];
-                    turn(plane[a], plane[b], p) < 0.0
-                        || turn(plane[b], plane[c], p) < 0.0
-                        || turn(plane[c], plane[a], p) < 0.0
+                    let outside = |x: usize, y: usize| turn(x, y, q) == Sign::Negative;
+                    outside(a, b) || outside(b, c) || outside(c, a)
                 })
         });
         // The best shaped ear first: the front over the patch is made of these triangles.
-        let ear = ear.max_by(|&i, &j| {
-            let shape = |i: usize| {
-                let (a, b, c) = corners(i);
-                min_angle_2d(plane[a], plane[b], plane[c])
-            };
-            shape(i).total_cmp(&shape(j))
-        })?;
-        triangles.push([left[(ear + n - 1) % n], left[ear], left[(ear + 1) % n]]);
+        let shape = |i: usize| {
+            let (a, b, c) = corners(i);
+            triangle_min_angle(plane[a], plane[b], plane[c])
+        };
+        let ear = ears.max_by(|&i, &j| shape(i).total_cmp(&shape(j)))?;
+        let (a, b, c) = corners(ear);
+        triangles.push([a, b, c]);
         left.remove(ear);
     }
     let [a, b, c] = [left[0], left[1], left[2]];
-    (turn(plane[a], plane[b], plane[c]) > 0.0).then_some(())?;
+    (turn(a, b, c) == Sign::Positive).then_some(())?;
     triangles.push([a, b, c]);
     Some(triangles)
 }

@@ -8,7 +8,7 @@ use super::features::{FeatureCounts, Features};
 use super::topology::Topology;
 use super::validate::{format_coordinate, format_point, validate, ValidationOptions};
 use super::Surface;
-use crate::geometry::{Aabb, DVec3};
+use crate::geometry::{triangle_min_angle, Aabb};
 
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
 pub struct PatchInfo {
@@ -133,17 +133,13 @@ fn edge_length_range(surface: &Surface, topology: &Topology) -> (Option<f64>, Op
 
 /// Smallest corner angle of any triangle, in degrees.
 fn min_angle_deg(surface: &Surface) -> Option<f64> {
-    let corner_angle = |p: DVec3, q: DVec3, r: DVec3| {
-        let (u, v) = (q - p, r - p);
-        u.cross(v).length().atan2(u.dot(v)).to_degrees()
-    };
     surface
         .triangles
         .iter()
         .filter_map(|tri| {
             let [a, b, c] = [0, 1, 2].map(|i| surface.points.get(tri[i] as usize).copied());
             let (a, b, c) = (a?, b?, c?);
-            let angle = corner_angle(a, b, c).min(corner_angle(b, c, a)).min(corner_angle(c, a, b));
+            let angle = triangle_min_angle(a, b, c);
             Some(angle).filter(|x| x.is_finite())
         })
         .min_by(f64::total_cmp)
