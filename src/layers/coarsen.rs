@@ -46,7 +46,7 @@ pub(super) fn collapse_short_edges(
             if touched[a as usize] || touched[b as usize] || !plan.merges.can_collapse(front, a, b) {
                 continue;
             }
-            if try_collapse(plan, columns, a, b, &cells_valid) {
+            if entropy::try_collapse(plan, columns, a, b, &cells_valid) {
                 touched[a as usize] = true;
                 touched[b as usize] = true;
                 made += 1;
@@ -77,29 +77,4 @@ fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, h: &[f64]) -> 
             (length < COLLAPSE_LENGTH).then_some((length, a as u32, b as u32))
         })
         .collect()
-}
-
-/// Merge roots `a` and `b`; undo the merge (and keep the plan as it was) if a cell around them
-/// turns invalid.
-fn try_collapse(
-    plan: &mut SlabPlan,
-    columns: &Columns,
-    a: u32,
-    b: u32,
-    cells_valid: &impl Fn(&SlabPlan, &[u32]) -> bool,
-) -> bool {
-    let saved = (plan.proposed[a as usize], plan.proposed[b as usize], plan.redirected.len());
-    let merges_before = plan.merges.clone_groups(a, b);
-    entropy::collapse(plan, columns, a, b);
-    let keep = plan.merges.root(a);
-    let group: Vec<u32> = plan.merges.group(keep).collect();
-    if cells_valid(plan, &group) {
-        return true;
-    }
-    plan.merges.restore_groups(merges_before);
-    plan.proposed[a as usize] = saved.0;
-    plan.proposed[b as usize] = saved.1;
-    plan.redirected.truncate(saved.2);
-    plan.collapses -= 1;
-    false
 }

@@ -19,6 +19,7 @@ use glam::DVec3;
 
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
+use crate::surface::Surface;
 
 /// Two columns meet when their proposed top edge keeps less than this fraction of its bottom
 /// edge: merging them then moves neither far (merging columns still apart twists the lateral
@@ -82,6 +83,153 @@ pub(super) fn collapse_crushed_edge(
         .or_else(|| collapse_crossing_corner(plan, front, f, columns, points))?;
     Some(plan.merges.group(root).collect())
 }
+
+/// Merge every face column whose proposed top passes the bisector of a ridge or corner column
+/// next to it into that column, before any cell is tested; returns the columns whose cells
+/// changed. This is the entropy collapse where it is due, whatever the shape of the cells: a
+/// face column of wall 1 beside a concave ridge has crossed the bisector once its top is nearer
+/// the other wall's offset than its own, i.e. past the plane through the ridge column's top
+/// normal to `n - (n . d) d` (`n` its direction, `d` the ridge column's). The cells' tests see
+/// such a crossing late or not at all where the wall's edges run obliquely to the ridge, and
+/// merge the wrong edge then (two face columns with each other, off the bisector).
+pub(super) fn merge_bisector_crossings(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
+) -> Vec<u32> {
+    let mut changed = Vec::new();
+    let mut next = Vec::new();
+    loop {
+        let mut merged = false;
+        for c in 0..columns.len() as u32 {
+            if !plan.moving[c as usize] || plan.merges.is_merged(c) {
+                continue;
+            }
+            next.clear();
+            for g in plan.merges.group(c) {
+                front.neighbours(g as usize, &mut next);
+            }
+            // The nearest bisector it has passed (one ridge column beside another may see the
+            // same crossing: the nearer keeps the front's cells in shape).
+            let top = |x: u32| plan.proposed[x as usize];
+            let Some(r) = next
+                .iter()
+                .map(|&x| plan.merges.root(x as u32))
+                .filter(|&r| {
+                    columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
+                        && crosses_bisector(plan, columns, points, walls, r, c)
+                })
+                .min_by(|&x, &y| top(x).distance_squared(top(c)).total_cmp(&top(y).distance_squared(top(c))))
+            else {
+                continue;
+            };
+            if !can_merge(plan, front, columns, r, c) {
+                continue;
+            }
+            // Not into more invalid cells than it leaves (the crossing may have turned some over
+            // already: the cells' repairs mend those).
+            let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
+            let before = invalid_cells(plan, &group);
+            if try_collapse(plan, columns, r, c, &|plan, group| invalid_cells(plan, group) <= before) {
+                changed.extend(plan.merges.group(r));
+                merged = true;
+            }
+        }
+        if !merged {
+            break;
+        }
+    }
+    changed.sort_unstable();
+    changed.dedup();
+    changed
+}
+
+/// The edge from a ridge column to a face column must run this much across the bisector
+/// (cosine of its angle to the bisector plane's normal): ridge edges lie in the plane.
+const ACROSS_RIDGE: f64 = 0.1;
+
+/// A column's direction within this cosine of a wall triangle's normal is that wall's.
+const SAME_WALL_COSINE: f64 = 0.9;
+
+/// The normals of the wall triangles at every wall vertex.
+pub struct VertexWalls {
+    offsets: Vec<u32>,
+    normals: Vec<DVec3>,
+}
+
+impl VertexWalls {
+    pub fn new(surface: &Surface) -> Self {
+        let mut offsets = vec![0u32; surface.points.len() + 1];
+        for tri in &surface.triangles {
+            for &v in tri {
+                offsets[v as usize + 1] += 1;
+            }
+        }
+        for v in 0..surface.points.len() {
+            offsets[v + 1] += offsets[v];
+        }
+        let mut fill = offsets.clone();
+        let mut normals = vec![DVec3::ZERO; offsets[surface.points.len()] as usize];
+        for (t, tri) in surface.triangles.iter().enumerate() {
+            for &v in tri {
+                normals[fill[v as usize] as usize] = surface.triangle_normal(t);
+                fill[v as usize] += 1;
+            }
+        }
+        VertexWalls { offsets, normals }
+    }
+
+    /// The normals at wall vertex `v` (none for a vertex off the surface).
+    pub fn at(&self, v: u32) -> &[DVec3] {
+        match (self.offsets.get(v as usize), self.offsets.get(v as usize + 1)) {
+            (Some(&lo), Some(&hi)) => &self.normals[lo as usize..hi as usize],
+            _ => &[],
+        }
+    }
+}
+
+/// Directions closer than this (the length of `n - (n . d) d`, the sine of their angle) leave
+/// the bisector test undecided.
+const MIN_BISECTOR_SINE: f64 = 0.2;
+
+/// Whether column `c`'s proposed top has passed the bisector through ridge (or corner) column
+/// `r` that its bottom is short of (see [`merge_bisector_crossings`]).
+fn crosses_bisector(
+    plan: &SlabPlan,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    r: u32,
+    c: u32,
+) -> bool {
+    let (d, n) = (columns.dir[r as usize], columns.dir[c as usize]);
+    let across = n - n.dot(d) * d;
+    // `r` must be the bisector of `c`'s wall and another at its vertex: `c`'s direction
+    // mirrored about `d` is that other wall's normal (not so for a fan's column at a saddle,
+    // nor at a corner of three walls, which the cells' tests handle).
+    let walls_at_r = walls.at(columns.wall_vertex[r as usize]);
+    let is_wall = |m: DVec3| walls_at_r.iter().any(|w| w.dot(m) >= SAME_WALL_COSINE);
+    if across.length() < MIN_BISECTOR_SINE || !is_wall(n) || !is_wall(2.0 * n.dot(d) * d - n) {
+        return false;
+    }
+    let bottom = |x: u32| points[columns.node[x as usize] as usize];
+    let top = |x: u32| plan.proposed[x as usize];
+    let apart = bottom(c) - bottom(r);
+    let (before, after) = (apart.dot(across), (top(c) - top(r)).dot(across));
+    // An edge along the ridge (where it fades out, say) starts on the bisector: no crossing.
+    if -before < ACROSS_RIDGE * across.length() * apart.length() {
+        return false;
+    }
+    // Passed, or closer than half the way it closes in this layer: the next layer would take
+    // it past by more than it is short now.
+    before < 0.0 && after + ANTICIPATION * (after - before) >= 0.0
+}
+
+/// The fraction of its last approach to a bisector by which a column is merged early.
+const ANTICIPATION: f64 = 0.5;
 
 /// Collapse the corner of invalid triangle `f` that closes in fastest on its opposite edge into
 /// the nearer end of that edge, if the front allows it; returns the surviving root. This is a
@@ -231,9 +379,80 @@ pub(super) fn collapse(plan: &mut SlabPlan, columns: &Columns, a: u32, b: u32) {
     plan.collapses += 1;
 }
 
+/// Merge roots `a` and `b`; undo the merge (and keep the plan as it was) if a cell around them
+/// turns invalid.
+pub(super) fn try_collapse(
+    plan: &mut SlabPlan,
+    columns: &Columns,
+    a: u32,
+    b: u32,
+    cells_valid: &impl Fn(&SlabPlan, &[u32]) -> bool,
+) -> bool {
+    let saved = (plan.proposed[a as usize], plan.proposed[b as usize], plan.redirected.len());
+    let merges_before = plan.merges.clone_groups(a, b);
+    collapse(plan, columns, a, b);
+    let keep = plan.merges.root(a);
+    let group: Vec<u32> = plan.merges.group(keep).collect();
+    if cells_valid(plan, &group) {
+        return true;
+    }
+    plan.merges.restore_groups(merges_before);
+    plan.proposed[a as usize] = saved.0;
+    plan.proposed[b as usize] = saved.1;
+    plan.redirected.truncate(saved.2);
+    plan.collapses -= 1;
+    false
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::layers::front::ColumnStart;
+
+    /// A 90-degree concave ridge along z at the origin between wall 1 (y = 0, x > 0, normal +y)
+    /// and wall 2 (x = 0, y > 0, normal +x): column 0 on the ridge, column 1 at `at` on the
+    /// wall with direction `dir`, both `d` out (the ridge column by its scale, on the bisector).
+    fn ridge_case(at: DVec3, dir: DVec3, d: f64) -> bool {
+        let mut columns = Columns::default();
+        let bisector = DVec3::new(1.0, 1.0, 0.0).normalize();
+        for (c, (base, dir, scale)) in
+            [(DVec3::ZERO, bisector, 2f64.sqrt()), (at, dir, 1.0)].into_iter().enumerate()
+        {
+            columns.push(ColumnStart {
+                base,
+                dir,
+                scale,
+                node: c as u32,
+                layers: 0,
+                wall_vertex: 0,
+                slide: Default::default(),
+                spec: None,
+                last_step: 0.0,
+            });
+        }
+        let plan = SlabPlan {
+            moving: vec![true; 2],
+            proposed: vec![bisector * 2f64.sqrt() * d, at + dir * d],
+            merges: super::super::collapse::Merges::new(2),
+            redirected: Vec::new(),
+            collapses: 0,
+            coarsened: 0,
+        };
+        let walls = VertexWalls { offsets: vec![0, 2], normals: vec![DVec3::Y, DVec3::X] };
+        crosses_bisector(&plan, &columns, &[DVec3::ZERO, at], &walls, 0, 1)
+    }
+
+    #[test]
+    fn a_face_column_passes_the_bisector_when_the_other_wall_is_nearer() {
+        let at = DVec3::new(0.1, 0.0, 0.0);
+        assert!(!ridge_case(at, DVec3::Y, 0.05), "half way: nearer its own wall");
+        assert!(ridge_case(at, DVec3::Y, 0.1), "on the bisector");
+        // Short of it by less than half of what it closed in on it this layer.
+        assert!(ridge_case(at, DVec3::Y, 0.09));
+        // A column not of these walls (a saddle fan's), and one along the ridge, never cross.
+        assert!(!ridge_case(at, DVec3::Z, 0.2));
+        assert!(!ridge_case(DVec3::new(0.0, 0.0, 0.1), DVec3::Y, 0.2));
+    }
 
     /// A corner overtaking its opposite edge while no edge of the triangle shrinks much.
     #[test]

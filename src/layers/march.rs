@@ -13,6 +13,7 @@
 use rayon::prelude::*;
 
 use super::collapse::Merges;
+use super::entropy::VertexWalls;
 use super::front::{Columns, Front};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
@@ -341,6 +342,7 @@ pub fn march(
     front: &mut Front,
     max_layers: u32,
     sizes: &mut Sizes,
+    walls: &VertexWalls,
     mut on_layer: impl FnMut(u32),
 ) -> MarchStats {
     let mut stats = MarchStats::default();
@@ -379,7 +381,7 @@ pub fn march(
             }
         };
         proposed.extend_from_slice(&reshape.splits.top);
-        let plan = settle_slab(mesh, columns, front, proposed, &mut reshape, sizes, &mut guard, k);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut reshape, sizes, walls, &mut guard, k);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses - plan.coarsened;
@@ -544,6 +546,7 @@ fn settle_slab(
     proposed: Vec<DVec3>,
     reshape: &mut Reshape,
     sizes: &Sizes,
+    walls: &VertexWalls,
     guard: &mut CrossingGuard,
     k: u32,
 ) -> SlabPlan {
@@ -555,18 +558,23 @@ fn settle_slab(
         collapses: 0,
         coarsened: 0,
     };
+    let committed = mesh.points.len() as u32;
+    // How many cells around the columns `group` are invalid under a plan.
+    let invalid_cells = |plan: &SlabPlan, group: &[u32]| {
+        let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+        front
+            .faces_around_columns(group)
+            .into_iter()
+            .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
+            .count()
+    };
     if !matches!(sizes.adapt, Adapt::Off) {
-        let committed = mesh.points.len() as u32;
-        let reshape = &*reshape;
         plan.coarsened =
             coarsen::collapse_short_edges(&mut plan, front, columns, &reshape.target, |plan, group| {
-                let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-                front
-                    .faces_around_columns(group)
-                    .into_iter()
-                    .all(|f| proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
+                invalid_cells(plan, group) == 0
             });
     }
+    entropy::merge_bisector_crossings(&mut plan, front, columns, &mesh.points, walls, invalid_cells);
     let mut to_check: Vec<usize> = (0..front.len()).collect();
     // Two faces that do not move cannot start to cross: only moving ones are suspects.
     let mut suspects: Vec<usize> = (0..front.len())

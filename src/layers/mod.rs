@@ -80,7 +80,8 @@ pub fn build_layers(
         ..Default::default()
     };
     let mut sizes = split::Sizes::new(adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
-    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, |k| {
+    let walls = entropy::VertexWalls::new(surface);
+    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, &walls, |k| {
         on_layer(k, max_layers)
     });
     let front_edges = sizes.front_edge_lengths(&mesh.points, &columns, &front);
