@@ -56,17 +56,40 @@ pub(super) fn check_boundary_kept(boundary: &ClosedBoundary, core: &CoreTets) ->
     }
 }
 
-/// How many of the guide's interior points, from the first, are still where they were given,
-/// as the points after the boundary's (call after [`drop_unused_points`]: the mesher may move or
-/// drop them, and TetGen's optimisation smooths them like its own; after the first one missing,
-/// the others are out of place).
-pub(super) fn interior_points_in_place(
+/// Put the guide's interior points that are still where they were given (the mesher may move
+/// or drop some, and TetGen's optimisation smooths them like its own) right after the
+/// boundary's, in the guide's order, renumbering the tetrahedra; returns how many there are.
+/// Then the fixed prefix of points holds every seed in place, not only those before the first
+/// one missing.
+pub(super) fn seeds_in_place_first(
     boundary: &ClosedBoundary,
     guide: &CoreGuide,
-    core: &CoreTets,
+    core: &mut CoreTets,
 ) -> usize {
     let n = boundary.points.len();
-    guide.interior.iter().zip(core.points.get(n..).unwrap_or_default()).take_while(|(g, p)| g == p).count()
+    let key = |p: DVec3| p.to_array().map(f64::to_bits);
+    let mut at: HashMap<[u64; 3], usize> = HashMap::with_capacity(core.points.len().saturating_sub(n));
+    for (i, p) in core.points.iter().enumerate().skip(n) {
+        at.entry(key(*p)).or_insert(i);
+    }
+    let mut placed = vec![false; core.points.len()];
+    let mut order: Vec<usize> = (0..n).collect();
+    for i in guide.interior.iter().filter_map(|g| at.get(&key(*g)).copied()) {
+        if !std::mem::replace(&mut placed[i], true) {
+            order.push(i);
+        }
+    }
+    let in_place = order.len() - n;
+    order.extend((n..core.points.len()).filter(|&i| !placed[i]));
+    let mut new_index = vec![0u32; core.points.len()];
+    for (new, &old) in order.iter().enumerate() {
+        new_index[old] = new as u32;
+    }
+    core.points = order.iter().map(|&i| core.points[i]).collect();
+    for t in &mut core.tets {
+        *t = t.map(|v| new_index[v as usize]);
+    }
+    in_place
 }
 
 /// Drop the points after the first `fixed` that no tetrahedron uses (a mesher may leave an

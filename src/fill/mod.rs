@@ -449,7 +449,7 @@ fn fill_keeping_boundary(
     loop {
         let mut tets = mesher.fill(boundary, &guide)?;
         merge::drop_unused_points(&mut tets, n);
-        let seeds_used = merge::interior_points_in_place(boundary, &guide, &tets);
+        let seeds_used = merge::seeds_in_place_first(boundary, &guide, &mut tets);
         let lost = match merge::check_boundary_kept(boundary, &tets) {
             Ok(()) => return Ok((tets, seeds_used)),
             Err(FillError::BoundaryNotKept { triangle, .. }) if !guide.interior.is_empty() => triangle,

@@ -243,3 +243,24 @@ fn a_lost_boundary_triangle_is_retried_without_the_seeds_near_it() {
         Err(FillError::BoundaryNotKept { triangle: 0, .. })
     ));
 }
+
+#[test]
+fn seeds_still_in_place_come_first_after_the_boundary() {
+    let (boundary, _) = one_tetrahedron(1.0);
+    let seeds = [DVec3::splat(0.1), DVec3::splat(0.2), DVec3::splat(0.15)];
+    let guide = CoreGuide { interior: seeds.to_vec(), size: Vec::new() };
+    // The mesher moved the first seed, added a point of its own first, and kept the others.
+    let moved = DVec3::splat(0.11);
+    let own = DVec3::new(0.2, 0.1, 0.1);
+    let mut core = CoreTets {
+        points: [boundary.points.clone(), vec![own, moved, seeds[2], seeds[1]]].concat(),
+        tets: vec![[0, 1, 2, 4], [0, 1, 5, 6], [1, 2, 7, 4]],
+        boundary_steiner_points: 0,
+    };
+    let before: Vec<[DVec3; 4]> = core.tets.iter().map(|t| t.map(|v| core.points[v as usize])).collect();
+    assert_eq!(merge::seeds_in_place_first(&boundary, &guide, &mut core), 2);
+    assert_eq!(&core.points[4..6], &[seeds[1], seeds[2]], "in the guide's order");
+    assert_eq!(&core.points[..4], &boundary.points[..]);
+    let after: Vec<[DVec3; 4]> = core.tets.iter().map(|t| t.map(|v| core.points[v as usize])).collect();
+    assert_eq!(before, after, "the tetrahedra keep their corners");
+}
