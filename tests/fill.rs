@@ -345,12 +345,12 @@ fn auto_layers_on_a_sphere_end_without_a_size_jump() {
 
 /// Issue 5's bars with the defaults (h0 = 1e-3 D, 10 layers and transition layers to isotropy)
 /// on the shipped examples: the first core tetrahedron on a front triangle is within [1/r, r]
-/// of the last layer under it at 95% of the front triangles on the sphere (97.3% measured), and
-/// the core has no dihedral angle below 10 degrees. The box reaches 92.1%: where stacks end one
-/// layer apart, the lower step's core cell reaches the upper step's front node.
+/// of the last layer under it at 95% of the front triangles (sphere 99.2%, box 96.5% measured,
+/// after the flips that match the first core cells to the last layer), and the core has no
+/// dihedral angle below 10 degrees.
 #[test]
 fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
-    for (name, within) in [("sphere.stl", 0.95), ("box.stl", 0.9)] {
+    for (name, within) in [("sphere.stl", 0.95), ("box.stl", 0.95)] {
         let path = format!("{}/examples/{name}", env!("CARGO_MANIFEST_DIR"));
         let surface = blmesh::io::read_surface(Path::new(&path)).expect("the example reads");
         let out = run(surface, &Config::default(), &MeshOptions { core: true }, Progress::hidden())
@@ -366,4 +366,19 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
             core.quality.min_dihedral
         );
     }
+}
+
+/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 96.9% of the front triangles'
+/// first core tetrahedra within [1/r, r] of the last layer (94.5% before the flips that match
+/// them). Its core still has tetrahedra below 10 degrees, so the angle bar is not asserted.
+#[test]
+fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
+    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/fandisk.obj");
+    let surface = blmesh::io::read_surface(Path::new(path)).expect("fandisk reads");
+    let out = run(surface, &Config::default(), &MeshOptions { core: true }, Progress::hidden())
+        .expect("fandisk meshes");
+    assert!(out.report.check.is_valid(), "{}", out.report.check);
+    let jump = &out.report.core.as_ref().expect("a core").size_jump.stats;
+    eprintln!("fandisk: size jump {jump:?}");
+    assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
 }

@@ -105,6 +105,9 @@ pub struct ImproveStats {
     pub edge_removals: usize,
     pub smoothed_points: usize,
     pub inserted_points: usize,
+    /// Flips that gave a first core tetrahedron the last layer's height
+    /// ([`TetMesh::match_front`]).
+    pub front_flips: usize,
     pub passes: usize,
     pub seconds: f64,
 }
@@ -216,6 +219,52 @@ impl TetMesh {
                 })
             })
             .count()
+    }
+
+    /// Give the front triangles whose first core tetrahedron is out of the band of their last
+    /// layer (the mesher joined them to a point of the front nearby, or to one of its own low
+    /// points) a better apex where a flip finds one: a 2-3 flip through a face at the apex, or
+    /// the removal of an edge from the apex to the triangle, makes a node beyond the apex the
+    /// triangle's. A flip is taken when it leaves fewer tetrahedra out of the band and none
+    /// below [`SLIVER_THRESHOLD`] (unless it removes one as bad). Returns the flips made.
+    pub fn match_front(&mut self) -> usize {
+        let mut triangles: Vec<[u32; 3]> = self.front_height.keys().copied().collect();
+        triangles.sort_unstable();
+        let mut made = 0;
+        for _ in 0..MATCH_ROUNDS {
+            let before = made;
+            for &key in &triangles {
+                let &[t] = &self.tets_with(&key)[..] else { continue };
+                let tet = self.tets[t as usize];
+                if self.front_mismatches(tet, None) == 0 {
+                    continue;
+                }
+                let Some(apex) = tet.into_iter().find(|v| !key.contains(v)) else { continue };
+                let flips = (0..3).filter_map(|i| self.flip_23([key[i], key[(i + 1) % 3], apex]));
+                let removals = (0..3).filter_map(|i| self.remove_edge(apex, key[i]));
+                let best = flips
+                    .chain(removals)
+                    .filter_map(|change| {
+                        let mismatches = |tets: &mut dyn Iterator<Item = [u32; 4]>| {
+                            tets.map(|t| self.front_mismatches(t, None)).sum::<usize>()
+                        };
+                        let gain = mismatches(&mut change.remove.iter().map(|&t| self.tets[t as usize]))
+                            as i64
+                            - mismatches(&mut change.add.iter().copied()) as i64;
+                        (gain > 0 && change.after >= SLIVER_THRESHOLD.min(change.before))
+                            .then_some((gain, change))
+                    })
+                    .max_by(|x, y| x.0.cmp(&y.0).then(x.1.after.total_cmp(&y.1.after)));
+                if let Some((_, change)) = best {
+                    self.apply(&change);
+                    made += 1;
+                }
+            }
+            if made == before {
+                break;
+            }
+        }
+        made
     }
 
     /// The live tetrahedra.
@@ -638,6 +687,9 @@ impl TetMesh {
     pub fn improve(&mut self, options: &ImproveOptions) -> ImproveStats {
         let start = Instant::now();
         let mut stats = ImproveStats::default();
+        if options.passes > 0 {
+            stats.front_flips += self.match_front();
+        }
         self.passes(options.passes, options, Rule::FewerBad, options.target_dihedral, &mut stats);
         let worst_first = options.passes.min(WORST_FIRST_PASSES);
         self.passes(
@@ -1007,6 +1059,9 @@ pub struct CoreQuality {
 
 /// The core's quality bar: no tetrahedron with a dihedral angle below this, degrees.
 pub const SLIVER_THRESHOLD: f64 = 10.0;
+
+/// Rounds of [`TetMesh::match_front`] (a flip can open the way for another).
+const MATCH_ROUNDS: usize = 6;
 
 /// Improve the mesher's tetrahedra (`core`, filling `boundary`, whose points come first; they
 /// and the next up to `fixed` stay) and measure them before and after. `prism_height` is the

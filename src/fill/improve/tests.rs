@@ -255,3 +255,35 @@ fn no_change_takes_a_first_core_cell_off_the_last_layer_height() {
     assert!(lower(&mesh, 0.82).is_none(), "0.82 is below 1/1.2 of the layer");
     assert!(lower(&mesh, 0.9).is_some(), "0.9 is within the band");
 }
+
+/// A front triangle (0, 1, 2) at z = 0 under a last layer 1 high, joined by the mesher to a
+/// point 0.7 as high (3); the tetrahedron beyond the face (0, 1, 3) has a point at the layer's
+/// height (4): the 2-3 flip through that face makes 4 the triangle's apex.
+#[test]
+fn a_flip_gives_a_low_first_core_cell_the_last_layers_height() {
+    let points = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.5, 1.0, 0.0),
+        DVec3::new(0.5, 0.7, 0.7),
+        DVec3::new(0.5, -0.5, 1.0),
+    ];
+    let positive = |t: [u32; 4]| {
+        let x = t.map(|v| points[v as usize]);
+        if tet_signed_volume(x[0], x[1], x[2], x[3]) > 0.0 {
+            t
+        } else {
+            [t[1], t[0], t[2], t[3]]
+        }
+    };
+    let mut mesh = TetMesh::new(points.clone(), vec![positive([0, 1, 2, 3]), positive([0, 1, 3, 4])], 5);
+    let reference = mesh.clone();
+    mesh.keep_front_match(HashMap::from([([0, 1, 2], 1.0)]), 1.2);
+    let on_front = |mesh: &TetMesh| mesh.tets().find(|t| [0, 1, 2].iter().all(|v| t.contains(v)));
+    assert!(on_front(&mesh).unwrap().contains(&3));
+    assert_eq!(mesh.match_front(), 1);
+    assert!(on_front(&mesh).unwrap().contains(&4), "the point at the layer's height is its apex");
+    assert_consistent(&mesh, &reference);
+    assert!(mesh.tets().all(|t| angle_quality(t.map(|v| mesh.points[v as usize])) >= SLIVER_THRESHOLD));
+    assert_eq!(mesh.match_front(), 0, "nothing left to match");
+}
