@@ -3,12 +3,15 @@
 //! follows the first-arrival offset (the entropy solution of the eikonal equation) and keeps
 //! marching.
 //!
-//! A front face whose cell would be invalid while its columns converge (its proposed top keeps
-//! less area than its bottom) loses its most shrunk edge instead of stopping. The survivor is the column
-//! that already lies on the bisector: the one with the larger extrusion scale (a concave ridge
-//! column has `1/sin(phi/2)`, a corner column more, a face column 1), so the merged node stays on
-//! the Voronoi bisector at the exact wall distance. Between two columns of the same kind the
-//! merged column goes through the middle of their proposals, along their mean direction.
+//! A face column beside a concave ridge merges into the ridge's bisector column as soon as its
+//! proposed top passes the bisector ([`merge_bisector_crossings`]), before the cells are tested.
+//! Then, a front face whose cell would still be invalid while its columns converge (its proposed
+//! top keeps less area than its bottom) loses its most shrunk edge instead of stopping. The
+//! survivor is the column that already lies on the bisector: the one with the larger extrusion
+//! scale (a concave ridge column has `1/sin(phi/2)`, a corner column more, a face column 1), so the
+//! merged node stays on the Voronoi bisector at the exact wall distance. Between two columns of the
+//! same kind the merged column goes through the middle of their proposals, along their mean
+//! direction.
 //!
 //! Where the wall's edges run obliquely to a ridge, a face can turn over with no edge shrinking
 //! much: a corner closes in on its opposite edge (the bisector column passing the face columns
@@ -84,76 +87,6 @@ pub(super) fn collapse_crushed_edge(
     Some(plan.merges.group(root).collect())
 }
 
-/// Merge every face column whose proposed top passes the bisector of a ridge or corner column
-/// next to it into that column, before any cell is tested; returns the columns whose cells
-/// changed. This is the entropy collapse where it is due, whatever the shape of the cells: a
-/// face column of wall 1 beside a concave ridge has crossed the bisector once its top is nearer
-/// the other wall's offset than its own, i.e. past the plane through the ridge column's top
-/// normal to `n - (n . d) d` (`n` its direction, `d` the ridge column's). The cells' tests see
-/// such a crossing late or not at all where the wall's edges run obliquely to the ridge, and
-/// merge the wrong edge then (two face columns with each other, off the bisector).
-pub(super) fn merge_bisector_crossings(
-    plan: &mut SlabPlan,
-    front: &Front,
-    columns: &Columns,
-    points: &[DVec3],
-    walls: &VertexWalls,
-    invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
-) -> Vec<u32> {
-    let mut changed = Vec::new();
-    let mut next = Vec::new();
-    loop {
-        let mut merged = false;
-        for c in 0..columns.len() as u32 {
-            if !plan.moving[c as usize] || plan.merges.is_merged(c) {
-                continue;
-            }
-            next.clear();
-            for g in plan.merges.group(c) {
-                front.neighbours(g as usize, &mut next);
-            }
-            // The nearest bisector it has passed (one ridge column beside another may see the
-            // same crossing: the nearer keeps the front's cells in shape).
-            let top = |x: u32| plan.proposed[x as usize];
-            let Some(r) = next
-                .iter()
-                .map(|&x| plan.merges.root(x as u32))
-                .filter(|&r| {
-                    columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
-                        && crosses_bisector(plan, columns, points, walls, r, c)
-                })
-                .min_by(|&x, &y| top(x).distance_squared(top(c)).total_cmp(&top(y).distance_squared(top(c))))
-            else {
-                continue;
-            };
-            if !can_merge(plan, front, columns, r, c) {
-                continue;
-            }
-            // Not into more invalid cells than it leaves (the crossing may have turned some over
-            // already: the cells' repairs mend those).
-            let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
-            let before = invalid_cells(plan, &group);
-            if try_collapse(plan, columns, r, c, &|plan, group| invalid_cells(plan, group) <= before) {
-                changed.extend(plan.merges.group(r));
-                merged = true;
-            }
-        }
-        if !merged {
-            break;
-        }
-    }
-    changed.sort_unstable();
-    changed.dedup();
-    changed
-}
-
-/// The edge from a ridge column to a face column must run this much across the bisector
-/// (cosine of its angle to the bisector plane's normal): ridge edges lie in the plane.
-const ACROSS_RIDGE: f64 = 0.1;
-
-/// A column's direction within this cosine of a wall triangle's normal is that wall's.
-const SAME_WALL_COSINE: f64 = 0.9;
-
 /// The normals of the wall triangles at every wall vertex.
 pub struct VertexWalls {
     offsets: Vec<u32>,
@@ -191,12 +124,64 @@ impl VertexWalls {
     }
 }
 
-/// Directions closer than this (the length of `n - (n . d) d`, the sine of their angle) leave
-/// the bisector test undecided.
-const MIN_BISECTOR_SINE: f64 = 0.2;
+/// Merge every face column whose proposed top passes the bisector of a concave ridge column next to
+/// it into that column, before any cell is tested. This is the entropy collapse where it is due,
+/// whatever the shape of the cells: a face column of wall 1 beside a concave ridge has crossed the
+/// bisector once its top is nearer the other wall's offset than its own, i.e. past the plane
+/// through the ridge column's top normal to `n - (n . d) d` (`n` its direction, `d` the ridge
+/// column's). The cells' tests see such a crossing late or not at all where the wall's edges run
+/// obliquely to the ridge, and merge the wrong edge then (two face columns with each other, off the
+/// bisector).
+pub(super) fn merge_bisector_crossings(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
+) {
+    let mut next = Vec::new();
+    loop {
+        let mut merged = false;
+        for c in 0..columns.len() as u32 {
+            if !plan.moving[c as usize] || plan.merges.is_merged(c) {
+                continue;
+            }
+            next.clear();
+            for g in plan.merges.group(c) {
+                front.neighbours(g as usize, &mut next);
+            }
+            // The nearest bisector it has passed (one ridge column beside another may see the
+            // same crossing: the nearer keeps the front's cells in shape).
+            let top = |x: u32| plan.proposed[x as usize];
+            let Some(r) = next
+                .iter()
+                .map(|&x| plan.merges.root(x as u32))
+                .filter(|&r| {
+                    columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
+                        && crosses_bisector(plan, columns, points, walls, r, c)
+                })
+                .min_by(|&x, &y| top(x).distance_squared(top(c)).total_cmp(&top(y).distance_squared(top(c))))
+            else {
+                continue;
+            };
+            if !can_merge(plan, front, columns, r, c) {
+                continue;
+            }
+            // Not into more invalid cells than it leaves (the crossing may have turned some over
+            // already: the cells' repairs mend those).
+            let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
+            let before = invalid_cells(plan, &group);
+            merged |= try_collapse(plan, columns, r, c, &|plan, group| invalid_cells(plan, group) <= before);
+        }
+        if !merged {
+            break;
+        }
+    }
+}
 
-/// Whether column `c`'s proposed top has passed the bisector through ridge (or corner) column
-/// `r` that its bottom is short of (see [`merge_bisector_crossings`]).
+/// Whether column `c`'s proposed top has passed the bisector through concave ridge column `r`
+/// that its bottom is short of (see [`merge_bisector_crossings`]).
 fn crosses_bisector(
     plan: &SlabPlan,
     columns: &Columns,
@@ -227,6 +212,17 @@ fn crosses_bisector(
     // it past by more than it is short now.
     before < 0.0 && after + ANTICIPATION * (after - before) >= 0.0
 }
+
+/// The edge from a ridge column to a face column must run this much across the bisector
+/// (cosine of its angle to the bisector plane's normal): ridge edges lie in the plane.
+const ACROSS_RIDGE: f64 = 0.1;
+
+/// A column's direction within this cosine of a wall triangle's normal is that wall's.
+const SAME_WALL_COSINE: f64 = 0.9;
+
+/// Directions closer than this (the length of `n - (n . d) d`, the sine of their angle) leave
+/// the bisector test undecided.
+const MIN_BISECTOR_SINE: f64 = 0.2;
 
 /// The fraction of its last approach to a bisector by which a column is merged early.
 const ANTICIPATION: f64 = 0.5;
