@@ -464,8 +464,8 @@ impl std::fmt::Display for MeshReport {
                 )?;
                 writeln!(
                     f,
-                    "          improvement: {} flips to match the front's first cells to the last layer, then {} flips 2-3, {} 3-2, {} 4-4, {} larger edge removals, {} points smoothed, {} inserted ({:.2} s)",
-                    i.front_flips, i.flips_23, i.flips_32, i.flips_44, i.edge_removals, i.smoothed_points, i.inserted_points, i.seconds
+                    "          improvement: {} flips and moves to match the first core cells to the last layer, then {} flips 2-3, {} 3-2, {} 4-4, {} larger edge removals, {} points smoothed, {} inserted ({:.2} s)",
+                    i.front_matches, i.flips_23, i.flips_32, i.flips_44, i.edge_removals, i.smoothed_points, i.inserted_points, i.seconds
                 )?;
                 writeln!(
                     f,

@@ -105,9 +105,9 @@ pub struct ImproveStats {
     pub edge_removals: usize,
     pub smoothed_points: usize,
     pub inserted_points: usize,
-    /// Flips that gave a first core tetrahedron the last layer's height
+    /// Flips and moves that gave a first core tetrahedron the last layer's height
     /// ([`TetMesh::match_front`]).
-    pub front_flips: usize,
+    pub front_matches: usize,
     pub passes: usize,
     pub seconds: f64,
 }
@@ -225,8 +225,9 @@ impl TetMesh {
     /// layer (the mesher joined them to a point of the front nearby, or to one of its own low
     /// points) a better apex where a flip finds one: a 2-3 flip through a face at the apex, or
     /// the removal of an edge from the apex to the triangle, makes a node beyond the apex the
-    /// triangle's. A flip is taken when it leaves fewer tetrahedra out of the band and none
-    /// below [`SLIVER_THRESHOLD`] (unless it removes one as bad). Returns the flips made.
+    /// triangle's; or an apex the mesher added moves into the band along the triangle's normal.
+    /// A change is taken when it leaves fewer tetrahedra out of the band and none below
+    /// [`SLIVER_THRESHOLD`] (unless it removes one as bad). Returns the changes made.
     pub fn match_front(&mut self) -> usize {
         let mut triangles: Vec<[u32; 3]> = self.front_height.keys().copied().collect();
         triangles.sort_unstable();
@@ -244,13 +245,9 @@ impl TetMesh {
                 let removals = (0..3).filter_map(|i| self.remove_edge(apex, key[i]));
                 let best = flips
                     .chain(removals)
+                    .chain(self.raise_apex(key, apex))
                     .filter_map(|change| {
-                        let mismatches = |tets: &mut dyn Iterator<Item = [u32; 4]>| {
-                            tets.map(|t| self.front_mismatches(t, None)).sum::<usize>()
-                        };
-                        let gain = mismatches(&mut change.remove.iter().map(|&t| self.tets[t as usize]))
-                            as i64
-                            - mismatches(&mut change.add.iter().copied()) as i64;
+                        let gain = self.mismatch_gain(&change);
                         (gain > 0 && change.after >= SLIVER_THRESHOLD.min(change.before))
                             .then_some((gain, change))
                     })
@@ -265,6 +262,44 @@ impl TetMesh {
             }
         }
         made
+    }
+
+    /// Move the added point `apex` of front triangle `key`'s tetrahedron along the triangle's
+    /// normal into the band of the last layer's height over it.
+    fn raise_apex(&self, key: [u32; 3], apex: u32) -> Option<Change> {
+        let h = *self.front_height.get(&key)?;
+        if (apex as usize) < self.fixed {
+            return None;
+        }
+        let [a, b, c] = key.map(|v| self.points[v as usize]);
+        let normal = triangle_area_vector(a, b, c).normalize_or_zero();
+        let p = self.points[apex as usize];
+        let height = (p - a).dot(normal);
+        // Just into the band: the least move (a stretched triangle's tetrahedron as tall as
+        // its layer can be a needle).
+        let wanted = height.abs().clamp(h / self.band * 1.01, h * self.band / 1.01);
+        let target = p + normal * (wanted.copysign(height) - height);
+        let ball: Vec<[u32; 4]> = self.ball[apex as usize].iter().map(|&t| self.tets[t as usize]).collect();
+        let old: Vec<f64> = ball.iter().map(|&t| self.quality(t)).collect();
+        let new: Vec<f64> = ball.iter().map(|&t| self.quality_at(t, apex, target)).collect();
+        Some(Change::from_qualities(Vec::new(), Vec::new(), Some((apex, target)), &old, &new))
+    }
+
+    /// How many fewer tetrahedra `change` leaves out of the band of their last layer.
+    fn mismatch_gain(&self, change: &Change) -> i64 {
+        let count = |tets: &mut dyn Iterator<Item = [u32; 4]>, moved| {
+            tets.map(|t| self.front_mismatches(t, moved)).sum::<usize>() as i64
+        };
+        if change.remove.is_empty() {
+            // A point moved: its ball, before and after.
+            let Some((v, _)) = change.point else { return 0 };
+            let ball = &self.ball[v as usize];
+            count(&mut ball.iter().map(|&t| self.tets[t as usize]), None)
+                - count(&mut ball.iter().map(|&t| self.tets[t as usize]), change.point)
+        } else {
+            count(&mut change.remove.iter().map(|&t| self.tets[t as usize]), None)
+                - count(&mut change.add.iter().copied(), change.point)
+        }
     }
 
     /// The live tetrahedra.
@@ -688,7 +723,7 @@ impl TetMesh {
         let start = Instant::now();
         let mut stats = ImproveStats::default();
         if options.passes > 0 {
-            stats.front_flips += self.match_front();
+            stats.front_matches += self.match_front();
         }
         self.passes(options.passes, options, Rule::FewerBad, options.target_dihedral, &mut stats);
         let worst_first = options.passes.min(WORST_FIRST_PASSES);

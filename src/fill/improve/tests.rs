@@ -287,3 +287,21 @@ fn a_flip_gives_a_low_first_core_cell_the_last_layers_height() {
     assert!(mesh.tets().all(|t| angle_quality(t.map(|v| mesh.points[v as usize])) >= SLIVER_THRESHOLD));
     assert_eq!(mesh.match_front(), 0, "nothing left to match");
 }
+
+/// A front triangle's tetrahedron whose apex is a point the mesher added, 0.4 of the last
+/// layer high: the apex moves up along the triangle's normal into the band, no further.
+#[test]
+fn an_added_apex_too_low_for_the_last_layer_moves_into_its_band() {
+    let points = vec![
+        DVec3::new(0.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(0.0, 1.0, 0.0),
+        DVec3::new(0.3, 0.3, 0.4),
+    ];
+    let mut mesh = TetMesh::new(points, vec![[0, 1, 2, 3]], 3);
+    mesh.keep_front_match(HashMap::from([([0, 1, 2], 1.0)]), 1.2);
+    assert_eq!(mesh.match_front(), 1);
+    let apex = mesh.points[3];
+    assert!((apex.z - 1.01 / 1.2).abs() < 1e-12, "just into the band: {apex}");
+    assert_eq!((apex.x, apex.y), (0.3, 0.3), "along the normal");
+}
