@@ -368,7 +368,7 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
     }
 }
 
-/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 97.0% of the front triangles'
+/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 96.9% of the front triangles'
 /// first core tetrahedra within [1/r, r] of the last layer (94.5% before the flips that match
 /// them). Its core still has tetrahedra below 10 degrees, so the angle bar is not asserted.
 #[test]

@@ -208,8 +208,9 @@ fn crosses_bisector(
     if -before < ACROSS_RIDGE * across.length() * apart.length() {
         return false;
     }
-    // Passed, or closer than half the way it closes in this layer: the next layer would take
-    // it past by more than it is short now.
+    // Passed, or short of it by less than it closed in this layer: the next layer would take
+    // it past (at 0.5 of the approach: flange 89.8% near concave, fandisk 95.3%, arrow 68.1%;
+    // at 1: 93.7%, 95.9%, 69.3%; at 1.5 fandisk 97.6% but flange 86.9%).
     before < 0.0 && after + ANTICIPATION * (after - before) >= 0.0
 }
 
@@ -224,8 +225,8 @@ const SAME_WALL_COSINE: f64 = 0.9;
 /// the bisector test undecided.
 const MIN_BISECTOR_SINE: f64 = 0.2;
 
-/// The fraction of its last approach to a bisector by which a column is merged early.
-const ANTICIPATION: f64 = 0.5;
+/// How many of its last approaches to a bisector ahead a column is merged.
+const ANTICIPATION: f64 = 1.0;
 
 /// Collapse the corner of invalid triangle `f` that closes in fastest on its opposite edge into
 /// the nearer end of that edge, if the front allows it; returns the surviving root. This is a
@@ -441,9 +442,9 @@ mod tests {
     #[test]
     fn a_face_column_passes_the_bisector_when_the_other_wall_is_nearer() {
         let at = DVec3::new(0.1, 0.0, 0.0);
-        assert!(!ridge_case(at, DVec3::Y, 0.05), "half way: nearer its own wall");
+        assert!(!ridge_case(at, DVec3::Y, 0.04), "0.4 of the way: one more step leaves it short");
         assert!(ridge_case(at, DVec3::Y, 0.1), "on the bisector");
-        // Short of it by less than half of what it closed in on it this layer.
+        // Short of it by less than what it closed in on it this layer.
         assert!(ridge_case(at, DVec3::Y, 0.09));
         // A column not of these walls (a saddle fan's), and one along the ridge, never cross.
         assert!(!ridge_case(at, DVec3::Z, 0.2));
