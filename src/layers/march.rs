@@ -537,7 +537,8 @@ fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach
 
 /// Decide which columns move and merge so that every cell of the slab is valid and the new
 /// front does not cross itself: first the tangential collapses of short edges (unless
-/// adaptivity is off), then the repairs of invalid cells and of crossings.
+/// adaptivity is off), then the merges of face columns passing a concave ridge's bisector
+/// ([`entropy::merge_bisector_crossings`]), then the repairs of invalid cells and of crossings.
 #[allow(clippy::too_many_arguments)]
 fn settle_slab(
     mesh: &VolumeMesh,
