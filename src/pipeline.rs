@@ -187,10 +187,11 @@ pub fn run(
     };
     let bar = progress.bar(0, "layers");
     let (mut layered, core_wall) = timings.time("layers", || {
-        let mut layered = layers::build_layers(&surface, &wall_normals, &patch_spec, adapt, |k, n| {
-            bar.set_length(n as u64);
-            bar.set_position(k as u64);
-        });
+        let mut layered =
+            layers::build_layers(&surface, &topology, &wall_normals, &patch_spec, adapt, |k, n| {
+                bar.set_length(n as u64);
+                bar.set_position(k as u64);
+            });
         let core_wall =
             layers::sliding::close_sliding_patches(&mut layered.mesh, &surface, &planes, &symmetry_patch);
         (layered, core_wall)

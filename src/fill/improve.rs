@@ -17,6 +17,7 @@ use std::time::Instant;
 
 use serde::Serialize;
 
+use super::size_jump::height_over;
 use super::{sorted_triangle, ClosedBoundary, CoreTets, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
 use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::predicates::{orient3d, Sign};
@@ -210,11 +211,9 @@ impl TetMesh {
         };
         (0..4)
             .filter(|&apex| {
-                let mut key = [tet[(apex + 1) % 4], tet[(apex + 2) % 4], tet[(apex + 3) % 4]];
-                key.sort_unstable();
+                let key = sorted_triangle([tet[(apex + 1) % 4], tet[(apex + 2) % 4], tet[(apex + 3) % 4]]);
                 self.front_height.get(&key).is_some_and(|&h| {
-                    let normal = triangle_area_vector(x(key[0]), x(key[1]), x(key[2])).normalize_or_zero();
-                    let ratio = (x(tet[apex]) - x(key[0])).dot(normal).abs() / h;
+                    let ratio = height_over(key.map(x), x(tet[apex])).abs() / h;
                     !(1.0 / self.band..=self.band).contains(&ratio)
                 })
             })
@@ -279,10 +278,7 @@ impl TetMesh {
         // its layer can be a needle).
         let wanted = height.abs().clamp(h / self.band * 1.01, h * self.band / 1.01);
         let target = p + normal * (wanted.copysign(height) - height);
-        let ball: Vec<[u32; 4]> = self.ball[apex as usize].iter().map(|&t| self.tets[t as usize]).collect();
-        let old: Vec<f64> = ball.iter().map(|&t| self.quality(t)).collect();
-        let new: Vec<f64> = ball.iter().map(|&t| self.quality_at(t, apex, target)).collect();
-        Some(Change::from_qualities(Vec::new(), Vec::new(), Some((apex, target)), &old, &new))
+        Some(self.point_move(&self.ball_of(apex), apex, target))
     }
 
     /// How many fewer tetrahedra `change` leaves out of the band of their last layer.
@@ -290,7 +286,7 @@ impl TetMesh {
         let count = |tets: &mut dyn Iterator<Item = [u32; 4]>, moved| {
             tets.map(|t| self.front_mismatches(t, moved)).sum::<usize>() as i64
         };
-        if change.remove.is_empty() {
+        if change.remove.is_empty() && change.add.is_empty() {
             // A point moved: its ball, before and after.
             let Some((v, _)) = change.point else { return 0 };
             let ball = &self.ball[v as usize];
@@ -389,13 +385,11 @@ impl TetMesh {
         };
         let change = Change::from_qualities(remove, add, point, &old, &new);
         // A sliver may be mended at the cost of a first core cell's match, nothing less.
-        if change.before >= SLIVER_THRESHOLD && !self.front_height.is_empty() {
-            let before: usize =
-                change.remove.iter().map(|&t| self.front_mismatches(self.tets[t as usize], None)).sum();
-            let after: usize = change.add.iter().map(|&t| self.front_mismatches(t, change.point)).sum();
-            if after > before {
-                return None;
-            }
+        if change.before >= SLIVER_THRESHOLD
+            && !self.front_height.is_empty()
+            && self.mismatch_gain(&change) < 0
+        {
+            return None;
         }
         (change.after > INVALID).then_some(change)
     }
@@ -478,11 +472,21 @@ impl TetMesh {
         if (v as usize) < self.fixed {
             return None;
         }
-        let ball: Vec<[u32; 4]> = self.ball[v as usize].iter().map(|&t| self.tets[t as usize]).collect();
+        let ball = self.ball_of(v);
         let (p, _) = self.best_position(&ball, v, self.points[v as usize]);
+        Some(self.point_move(&ball, v, p))
+    }
+
+    /// The tetrahedra at point `v`.
+    fn ball_of(&self, v: u32) -> Vec<[u32; 4]> {
+        self.ball[v as usize].iter().map(|&t| self.tets[t as usize]).collect()
+    }
+
+    /// The change moving point `v`, whose tetrahedra are `ball`, to `p`.
+    fn point_move(&self, ball: &[[u32; 4]], v: u32, p: DVec3) -> Change {
         let old: Vec<f64> = ball.iter().map(|&t| self.quality(t)).collect();
         let new: Vec<f64> = ball.iter().map(|&t| self.quality_at(t, v, p)).collect();
-        Some(Change::from_qualities(Vec::new(), Vec::new(), Some((v, p)), &old, &new))
+        Change::from_qualities(Vec::new(), Vec::new(), Some((v, p)), &old, &new)
     }
 
     /// Insert a point on the interior edge `ab`, placed where the worst of its tetrahedra is

@@ -63,12 +63,17 @@ pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) 
             if let Some(&h) = last_height.get(&key([a, b, c])) {
                 let x = |n: u32| mesh.points[n as usize];
                 let apex = t.iter().copied().find(|n| ![a, b, c].contains(n)).map_or(x(a), x);
-                let normal = triangle_area_vector(x(a), x(b), x(c)).normalize_or_zero();
-                ratios.push((apex - x(a)).dot(normal).abs() / h);
+                ratios.push(height_over([x(a), x(b), x(c)], apex).abs() / h);
             }
         }
     }
     SizeJump { histogram: histogram(&ratios, growth), stats: RatioStats::of(ratios, 1.0 / growth, growth) }
+}
+
+/// The signed distance of `apex` from the plane of `triangle` (positive on the side its
+/// right-hand normal points to): a tetrahedron's height over that face.
+pub fn height_over([a, b, c]: [DVec3; 3], apex: DVec3) -> f64 {
+    (apex - a).dot(triangle_area_vector(a, b, c).normalize_or_zero())
 }
 
 /// The height of a prism (Gmsh order, bottom `0 1 2`, top `3 4 5`) under its top: the mean

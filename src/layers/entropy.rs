@@ -22,6 +22,7 @@ use glam::DVec3;
 
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
+use crate::surface::topology::Topology;
 use crate::surface::Surface;
 
 /// Two columns meet when their proposed top edge keeps less than this fraction of its bottom
@@ -87,40 +88,26 @@ pub(super) fn collapse_crushed_edge(
     Some(plan.merges.group(root).collect())
 }
 
-/// The normals of the wall triangles at every wall vertex.
-pub struct VertexWalls {
-    offsets: Vec<u32>,
+/// The normals of the wall triangles at every wall vertex (through the surface's topology).
+pub struct VertexWalls<'a> {
+    topology: &'a Topology,
+    /// Every wall triangle's unit normal.
     normals: Vec<DVec3>,
 }
 
-impl VertexWalls {
-    pub fn new(surface: &Surface) -> Self {
-        let mut offsets = vec![0u32; surface.points.len() + 1];
-        for tri in &surface.triangles {
-            for &v in tri {
-                offsets[v as usize + 1] += 1;
-            }
+impl<'a> VertexWalls<'a> {
+    pub fn new(surface: &Surface, topology: &'a Topology) -> Self {
+        VertexWalls {
+            topology,
+            normals: (0..surface.triangles.len()).map(|t| surface.triangle_normal(t)).collect(),
         }
-        for v in 0..surface.points.len() {
-            offsets[v + 1] += offsets[v];
-        }
-        let mut fill = offsets.clone();
-        let mut normals = vec![DVec3::ZERO; offsets[surface.points.len()] as usize];
-        for (t, tri) in surface.triangles.iter().enumerate() {
-            for &v in tri {
-                normals[fill[v as usize] as usize] = surface.triangle_normal(t);
-                fill[v as usize] += 1;
-            }
-        }
-        VertexWalls { offsets, normals }
     }
 
     /// The normals at wall vertex `v` (none for a vertex off the surface).
-    pub fn at(&self, v: u32) -> &[DVec3] {
-        match (self.offsets.get(v as usize), self.offsets.get(v as usize + 1)) {
-            (Some(&lo), Some(&hi)) => &self.normals[lo as usize..hi as usize],
-            _ => &[],
-        }
+    pub fn at(&self, v: u32) -> impl Iterator<Item = DVec3> + '_ {
+        let triangles =
+            if (v as usize) < self.topology.vertex_count() { self.topology.vertex_triangles(v) } else { &[] };
+        triangles.iter().map(|&t| self.normals[t as usize])
     }
 }
 
@@ -195,8 +182,7 @@ fn crosses_bisector(
     // `r` must be the bisector of `c`'s wall and another at its vertex: `c`'s direction
     // mirrored about `d` is that other wall's normal (not so for a fan's column at a saddle,
     // nor at a corner of three walls, which the cells' tests handle).
-    let walls_at_r = walls.at(columns.wall_vertex[r as usize]);
-    let is_wall = |m: DVec3| walls_at_r.iter().any(|w| w.dot(m) >= SAME_WALL_COSINE);
+    let is_wall = |m: DVec3| walls.at(columns.wall_vertex[r as usize]).any(|w| w.dot(m) >= SAME_WALL_COSINE);
     if across.length() < MIN_BISECTOR_SINE || !is_wall(n) || !is_wall(2.0 * n.dot(d) * d - n) {
         return false;
     }
@@ -435,7 +421,16 @@ mod tests {
             collapses: 0,
             coarsened: 0,
         };
-        let walls = VertexWalls { offsets: vec![0, 2], normals: vec![DVec3::Y, DVec3::X] };
+        // The ridge vertex 0 with one triangle on each wall.
+        let surface = Surface {
+            points: vec![DVec3::ZERO, DVec3::Z, DVec3::X, DVec3::Y],
+            triangles: vec![[0, 1, 2], [0, 3, 1]],
+            triangle_patch: vec![0, 0],
+            patch_names: vec!["wall".into()],
+        };
+        assert_eq!((surface.triangle_normal(0), surface.triangle_normal(1)), (DVec3::Y, DVec3::X));
+        let topology = Topology::new(&surface);
+        let walls = VertexWalls::new(&surface, &topology);
         crosses_bisector(&plan, &columns, &[DVec3::ZERO, at], &walls, 0, 1)
     }
 

@@ -21,6 +21,7 @@ use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
 use crate::normals::constraint::Slide;
 use crate::normals::WallNormals;
+use crate::surface::topology::Topology;
 use crate::surface::Surface;
 
 pub use march::MarchStats;
@@ -58,6 +59,7 @@ pub struct Layers {
 /// front's edges are split while it marches.
 pub fn build_layers(
     surface: &Surface,
+    topology: &Topology,
     normals: &WallNormals,
     patch_spec: &[Option<LayerSpec>],
     adapt: Adapt,
@@ -80,7 +82,7 @@ pub fn build_layers(
         ..Default::default()
     };
     let mut sizes = split::Sizes::new(adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
-    let walls = entropy::VertexWalls::new(surface);
+    let walls = entropy::VertexWalls::new(surface, topology);
     let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, &walls, |k| {
         on_layer(k, max_layers)
     });
