@@ -127,27 +127,17 @@ pub(super) fn merge_bisector_crossings(
     walls: &VertexWalls,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) {
-    let mut next = Vec::new();
     loop {
         let mut merged = false;
         for c in 0..columns.len() as u32 {
             if !plan.moving[c as usize] || plan.merges.is_merged(c) {
                 continue;
             }
-            next.clear();
-            for g in plan.merges.group(c) {
-                front.neighbours(g as usize, &mut next);
-            }
             // The nearest bisector it has passed (one ridge column beside another may see the
             // same crossing: the nearer keeps the front's cells in shape).
             let top = |x: u32| plan.proposed[x as usize];
-            let Some(r) = next
-                .iter()
-                .map(|&x| plan.merges.root(x as u32))
-                .filter(|&r| {
-                    columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
-                        && crosses_bisector(plan, columns, points, walls, r, c)
-                })
+            let Some(r) = passed_bisectors(plan, front, columns, points, walls, c, ANTICIPATION)
+                .into_iter()
                 .min_by(|&x, &y| top(x).distance_squared(top(c)).total_cmp(&top(y).distance_squared(top(c))))
             else {
                 continue;
@@ -167,6 +157,34 @@ pub(super) fn merge_bisector_crossings(
     }
 }
 
+/// The concave ridge columns (roots) beside root `c`'s group whose bisectors `c` has passed, or
+/// will within `anticipation` of its last approach ([`crosses_bisector`]).
+fn passed_bisectors(
+    plan: &SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    c: u32,
+    anticipation: f64,
+) -> Vec<u32> {
+    let mut next = Vec::new();
+    for g in plan.merges.group(c) {
+        front.neighbours(g as usize, &mut next);
+    }
+    let mut passed: Vec<u32> = next
+        .iter()
+        .map(|&x| plan.merges.root(x as u32))
+        .filter(|&r| {
+            columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
+                && crosses_bisector(plan, columns, points, walls, r, c, anticipation)
+        })
+        .collect();
+    passed.sort_unstable();
+    passed.dedup();
+    passed
+}
+
 /// Whether column `c`'s proposed top has passed the bisector through concave ridge column `r`
 /// that its bottom is short of (see [`merge_bisector_crossings`]).
 fn crosses_bisector(
@@ -176,6 +194,7 @@ fn crosses_bisector(
     walls: &VertexWalls,
     r: u32,
     c: u32,
+    anticipation: f64,
 ) -> bool {
     let (d, n) = (columns.dir[r as usize], columns.dir[c as usize]);
     let across = n - n.dot(d) * d;
@@ -197,8 +216,50 @@ fn crosses_bisector(
     // Passed, or short of it by less than it closed in this layer: the next layer would take
     // it past (at 0.5 of the approach: flange 89.8% near concave, fandisk 95.3%, arrow 68.1%;
     // at 1: 93.7%, 95.9%, 69.3%; at 1.5 fandisk 97.6% but flange 86.9%).
-    before < 0.0 && after + ANTICIPATION * (after - before) >= 0.0
+    before < 0.0 && after + anticipation * (after - before) >= 0.0
 }
+
+/// Repair invalid face `f` by merging one of its face columns into the bisector column beside it
+/// that it will pass within [`REPAIR_ANTICIPATION`] of its last approaches, if that leaves fewer
+/// invalid cells around; returns the surviving root. On a thin wall triangle along a ridge, one
+/// corner merging on time can turn the cell over while the next corner is a layer short of the
+/// bisector: merging that one early keeps the cell, where a general earlier merge would take the
+/// front off the offset elsewhere (at 1.5 approaches everywhere, the flange fell to 86.9%).
+pub(super) fn merge_before_crossing(
+    plan: &mut SlabPlan,
+    front: &Front,
+    f: usize,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
+) -> Option<u32> {
+    // The face may be down to an edge already (one corner merged).
+    let mut roots: Vec<u32> = front.face_columns(f).iter().map(|&c| plan.merges.root(c)).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    let mut candidates: Vec<(u32, u32)> = roots
+        .iter()
+        .flat_map(|&c| {
+            let passed = passed_bisectors(plan, front, columns, points, walls, c, REPAIR_ANTICIPATION);
+            passed.into_iter().map(move |r| (r, c))
+        })
+        .filter(|&(r, c)| can_merge(plan, front, columns, r, c))
+        .collect();
+    candidates.sort_unstable();
+    candidates.dedup();
+    for (r, c) in candidates {
+        let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
+        let before = invalid_cells(plan, &group);
+        if try_collapse(plan, columns, r, c, &|plan, group| invalid_cells(plan, group) < before) {
+            return Some(plan.merges.root(r));
+        }
+    }
+    None
+}
+
+/// How many of its last approaches to a bisector ahead a column may be merged to mend a cell.
+const REPAIR_ANTICIPATION: f64 = 2.0;
 
 /// The edge from a ridge column to a face column must run this much across the bisector
 /// (cosine of its angle to the bisector plane's normal): ridge edges lie in the plane.
@@ -396,6 +457,10 @@ mod tests {
     /// and wall 2 (x = 0, y > 0, normal +x): column 0 on the ridge, column 1 at `at` on the
     /// wall with direction `dir`, both `d` out (the ridge column by its scale, on the bisector).
     fn ridge_case(at: DVec3, dir: DVec3, d: f64) -> bool {
+        ridge_case_ahead(at, dir, d, ANTICIPATION)
+    }
+
+    fn ridge_case_ahead(at: DVec3, dir: DVec3, d: f64, anticipation: f64) -> bool {
         let mut columns = Columns::default();
         let bisector = DVec3::new(1.0, 1.0, 0.0).normalize();
         for (c, (base, dir, scale)) in
@@ -431,7 +496,7 @@ mod tests {
         assert_eq!((surface.triangle_normal(0), surface.triangle_normal(1)), (DVec3::Y, DVec3::X));
         let topology = Topology::new(&surface);
         let walls = VertexWalls::new(&surface, &topology);
-        crosses_bisector(&plan, &columns, &[DVec3::ZERO, at], &walls, 0, 1)
+        crosses_bisector(&plan, &columns, &[DVec3::ZERO, at], &walls, 0, 1, anticipation)
     }
 
     #[test]
@@ -444,6 +509,9 @@ mod tests {
         // A column not of these walls (a saddle fan's), and one along the ridge, never cross.
         assert!(!ridge_case(at, DVec3::Z, 0.2));
         assert!(!ridge_case(DVec3::new(0.0, 0.0, 0.1), DVec3::Y, 0.2));
+        // To mend a cell, a column two approaches short of the bisector merges, not three.
+        assert!(ridge_case_ahead(at, DVec3::Y, 0.04, REPAIR_ANTICIPATION));
+        assert!(!ridge_case_ahead(at, DVec3::Y, 0.02, REPAIR_ANTICIPATION));
     }
 
     /// A corner overtaking its opposite edge while no edge of the triangle shrinks much.

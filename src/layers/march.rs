@@ -559,23 +559,17 @@ fn settle_slab(
         collapses: 0,
         coarsened: 0,
     };
-    let committed = mesh.points.len() as u32;
-    // How many cells around the columns `group` are invalid under a plan.
-    let invalid_cells = |plan: &SlabPlan, group: &[u32]| {
-        let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
-        front
-            .faces_around_columns(group)
-            .into_iter()
-            .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
-            .count()
-    };
-    if !matches!(sizes.adapt, Adapt::Off) {
-        plan.coarsened =
-            coarsen::collapse_short_edges(&mut plan, front, columns, &reshape.target, |plan, group| {
-                invalid_cells(plan, group) == 0
-            });
+    {
+        let invalid_cells =
+            |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
+        if !matches!(sizes.adapt, Adapt::Off) {
+            plan.coarsened =
+                coarsen::collapse_short_edges(&mut plan, front, columns, &reshape.target, |plan, group| {
+                    invalid_cells(plan, group) == 0
+                });
+        }
+        entropy::merge_bisector_crossings(&mut plan, front, columns, &mesh.points, walls, invalid_cells);
     }
-    entropy::merge_bisector_crossings(&mut plan, front, columns, &mesh.points, walls, invalid_cells);
     let mut to_check: Vec<usize> = (0..front.len()).collect();
     // Two faces that do not move cannot start to cross: only moving ones are suspects.
     let mut suspects: Vec<usize> = (0..front.len())
@@ -585,7 +579,7 @@ fn settle_slab(
         // The faces whose tops the repairs changed (a column stopped or merged, a split or swap
         // given up) must be tested again too: a quad whose corner stopped may no longer be
         // cappable.
-        let repaired = repair_invalid_cells(&mut plan, reshape, mesh, columns, front, to_check);
+        let repaired = repair_invalid_cells(&mut plan, reshape, mesh, columns, front, walls, to_check);
         suspects.extend(repaired);
         suspects.sort_unstable();
         suspects.dedup();
@@ -606,18 +600,38 @@ fn settle_slab(
     }
 }
 
+/// How many cells around the columns `group` are invalid under `plan`.
+fn invalid_cells_around(
+    plan: &SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    group: &[u32],
+) -> usize {
+    let committed = mesh.points.len() as u32;
+    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    front
+        .faces_around_columns(group)
+        .into_iter()
+        .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
+        .count()
+}
+
 /// Check the cells over `to_check` and repair the invalid ones until every cell is valid: giving
 /// up their swap or splits, else a collapse where a cell is being crushed, else stopping its
 /// columns.
 /// Collapses come first: an invalid cell without a crushed edge of its own may be mended by a
 /// collapse next to it (its neighbour crosses the bisector in another cell), so its columns stop
 /// only after a round that collapsed nothing. Returns the faces whose cells changed.
+#[allow(clippy::too_many_arguments)]
 fn repair_invalid_cells(
     plan: &mut SlabPlan,
     reshape: &mut Reshape,
     mesh: &VolumeMesh,
     columns: &Columns,
     front: &Front,
+    walls: &VertexWalls,
     mut to_check: Vec<usize>,
 ) -> Vec<usize> {
     let committed = mesh.points.len() as u32;
@@ -641,7 +655,23 @@ fn repair_invalid_cells(
                 changed_faces.extend(given_up);
                 continue;
             }
-            match entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points) {
+            let merged =
+                entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points).or_else(|| {
+                    let invalid_cells = |plan: &SlabPlan, group: &[u32]| {
+                        invalid_cells_around(plan, reshape, mesh, columns, front, group)
+                    };
+                    let root = entropy::merge_before_crossing(
+                        plan,
+                        front,
+                        f,
+                        columns,
+                        &mesh.points,
+                        walls,
+                        &invalid_cells,
+                    )?;
+                    Some(plan.merges.group(root).collect())
+                });
+            match merged {
                 Some(merged) => changed.extend(merged),
                 None => uncollapsed.push(f),
             }
