@@ -220,8 +220,8 @@ fn crosses_bisector(
 }
 
 /// Repair invalid face `f` by merging one of its face columns into the bisector column beside it
-/// that it will pass within [`REPAIR_ANTICIPATION`] of its last approaches, if that leaves fewer
-/// invalid cells around; returns the surviving root. On a thin wall triangle along a ridge, one
+/// that it will pass within [`REPAIR_ANTICIPATION`] of its last approaches (with its fan mates,
+/// if it is a fan's), if that leaves fewer invalid cells around; returns the surviving root. On a thin wall triangle along a ridge, one
 /// corner merging on time can turn the cell over while the next corner is a layer short of the
 /// bisector: merging that one early keeps the cell, where a general earlier merge would take the
 /// front off the offset elsewhere (at 1.5 approaches everywhere, the flange fell to 86.9%).
@@ -251,8 +251,14 @@ pub(super) fn merge_before_crossing(
     for (r, c) in candidates {
         let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
         let before = invalid_cells(plan, &group);
-        if try_collapse(plan, columns, r, c, &|plan, group| invalid_cells(plan, group) < before) {
+        let fewer_invalid = |plan: &SlabPlan, group: &[u32]| invalid_cells(plan, group) < before;
+        if try_collapse(plan, columns, r, c, &fewer_invalid) {
             return Some(plan.merges.root(r));
+        }
+        // A fan column at a saddle: its fan mates beside the bisector column go with it, or the
+        // fan's cells between them turn over.
+        if let Some(root) = try_collapse_with_fan_mates(plan, front, columns, r, c, &fewer_invalid) {
+            return Some(root);
         }
     }
     None
@@ -313,6 +319,43 @@ fn can_merge(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, w: u32) 
         && !columns.is_fan_edge(v as usize, w as usize)
         && columns.slide[v as usize] == columns.slide[w as usize]
         && plan.merges.can_collapse(front, v, w)
+}
+
+/// Merge root `c` into root `r`, and with it the fan mates of `c` that can follow; undo it all
+/// unless `accept` holds for the merged group. Returns the surviving root.
+fn try_collapse_with_fan_mates(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    r: u32,
+    c: u32,
+    accept: &impl Fn(&SlabPlan, &[u32]) -> bool,
+) -> Option<u32> {
+    let saved = plan.clone();
+    collapse(plan, columns, r, c);
+    let mut next = Vec::new();
+    front.neighbours(c as usize, &mut next);
+    for &m in &next {
+        let (root, m) = (plan.merges.root(r), m as u32);
+        if columns.is_fan_edge(c as usize, m as usize) && can_merge_fan_mate(plan, front, columns, root, m) {
+            collapse(plan, columns, root, m);
+        }
+    }
+    let root = plan.merges.root(r);
+    let group: Vec<u32> = plan.merges.group(root).collect();
+    if accept(plan, &group) {
+        return Some(root);
+    }
+    *plan = saved;
+    None
+}
+
+/// Whether root `m`, a fan mate of a column merged into root `v`, may follow it: as
+/// [`can_merge`], but the fan edge is what joins them.
+fn can_merge_fan_mate(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, m: u32) -> bool {
+    moving_roots(plan, v, m)
+        && columns.slide[v as usize] == columns.slide[m as usize]
+        && plan.merges.can_collapse(front, v, m)
 }
 
 /// The corner of triangle `f` (after the merges so far) whose height over its opposite edge

@@ -124,6 +124,7 @@ fn split_pieces(
 }
 
 /// The decisions for one slab: which columns move, where to, and which merge.
+#[derive(Clone)]
 pub(super) struct SlabPlan {
     pub moving: Vec<bool>,
     pub proposed: Vec<DVec3>,
