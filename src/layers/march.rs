@@ -683,7 +683,9 @@ fn repair_invalid_cells(
                 if tracing::enabled!(tracing::Level::TRACE) {
                     trace_invalid_cell(plan, reshape, mesh, columns, front, f);
                 }
-                changed.extend(stop_face_columns(plan, front, columns, f));
+                let stopped = stop_fewest_columns(plan, reshape, mesh, columns, front, f)
+                    .unwrap_or_else(|| stop_face_columns(plan, front, columns, f));
+                changed.extend(stopped);
             }
             uncollapsed.clear();
         }
@@ -721,6 +723,53 @@ fn stop_face_columns(plan: &mut SlabPlan, front: &Front, columns: &Columns, f: u
         add_fan_mates(front, columns, &mut group);
     }
     plan.stop_all(group)
+}
+
+/// Stop the fewest columns that mend invalid face `f`: one root of it (with its fan mates on a
+/// fan face), if that leaves its cell valid and no more invalid cells around; the one whose
+/// stop holds the fewest columns. `None` when no single root does. A face whose far corner is
+/// still short of the bisector its other corners merged on needs only that corner stopped.
+fn stop_fewest_columns(
+    plan: &mut SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    f: usize,
+) -> Option<Vec<u32>> {
+    let mut roots: Vec<u32> = front.face_columns(f).iter().map(|&c| plan.merges.root(c)).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    if roots.len() < 2 {
+        return None;
+    }
+    let fan_face = {
+        let cols = front.face_columns(f);
+        (0..cols.len()).any(|i| columns.is_fan_edge(cols[i] as usize, cols[(i + 1) % cols.len()] as usize))
+    };
+    let committed = mesh.points.len() as u32;
+    let mut best: Option<(usize, SlabPlan, Vec<u32>)> = None;
+    for &r in &roots {
+        let mut group = vec![r];
+        if fan_face {
+            add_fan_mates(front, columns, &mut group);
+        }
+        let around: Vec<u32> = group.iter().flat_map(|&g| plan.merges.group(plan.merges.root(g))).collect();
+        let before = invalid_cells_around(plan, reshape, mesh, columns, front, &around);
+        let mut trial = plan.clone();
+        let changed = trial.stop_all(group);
+        let proposal = Proposal { points: &mesh.points, proposed: &trial.proposed, committed };
+        let mended = proposal.cell_is_valid(&face_cell(front, f, &trial, reshape, columns, committed));
+        if mended
+            && invalid_cells_around(&trial, reshape, mesh, columns, front, &changed) < before
+            && best.as_ref().is_none_or(|b| changed.len() < b.0)
+        {
+            best = Some((changed.len(), trial, changed));
+        }
+    }
+    let (_, trial, changed) = best?;
+    *plan = trial;
+    Some(changed)
 }
 
 /// Add to `group` the fan mates of its columns: the columns joined to them by fan edges.
