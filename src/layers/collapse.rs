@@ -78,6 +78,15 @@ impl Merges {
         released
     }
 
+    /// The distinct roots of face `f`'s columns, sorted (two or one where the face is down to an
+    /// edge or a point).
+    pub fn face_roots(&self, front: &Front, f: usize) -> Vec<u32> {
+        let mut roots: Vec<u32> = front.face_columns(f).iter().map(|&c| self.root(c)).collect();
+        roots.sort_unstable();
+        roots.dedup();
+        roots
+    }
+
     /// Face `f` with every column replaced by its root, repeated columns removed.
     pub fn resolved_face(&self, front: &Front, f: usize) -> Option<Polygon> {
         let cols: Vec<u32> = front.face_columns(f).iter().map(|&c| self.root(c)).collect();

@@ -235,10 +235,9 @@ pub(super) fn merge_before_crossing(
     invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
 ) -> Option<u32> {
     // The face may be down to an edge already (one corner merged).
-    let mut roots: Vec<u32> = front.face_columns(f).iter().map(|&c| plan.merges.root(c)).collect();
-    roots.sort_unstable();
-    roots.dedup();
-    let mut candidates: Vec<(u32, u32)> = roots
+    let mut candidates: Vec<(u32, u32)> = plan
+        .merges
+        .face_roots(front, f)
         .iter()
         .flat_map(|&c| {
             let passed = passed_bisectors(plan, front, columns, points, walls, c, REPAIR_ANTICIPATION);

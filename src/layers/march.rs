@@ -619,12 +619,33 @@ fn invalid_cells_around(
         .count()
 }
 
+/// Merge columns to mend the invalid cell over face `f`: its crushed edge ([`entropy::collapse_crushed_edge`]),
+/// else a face column of it merging early into the bisector it is about to pass
+/// ([`entropy::merge_before_crossing`]). Returns the columns whose cells changed.
+fn mend_by_merge(
+    plan: &mut SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    walls: &VertexWalls,
+    f: usize,
+) -> Option<Vec<u32>> {
+    if let Some(merged) = entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points) {
+        return Some(merged);
+    }
+    let invalid_cells =
+        |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
+    let root = entropy::merge_before_crossing(plan, front, f, columns, &mesh.points, walls, &invalid_cells)?;
+    Some(plan.merges.group(root).collect())
+}
+
 /// Check the cells over `to_check` and repair the invalid ones until every cell is valid: giving
-/// up their swap or splits, else a collapse where a cell is being crushed, else stopping its
-/// columns.
-/// Collapses come first: an invalid cell without a crushed edge of its own may be mended by a
+/// up their swap or splits, else merges that mend them ([`mend_by_merge`]), else stopping the
+/// fewest of their columns ([`stop_fewest_columns`]) or all of them.
+/// Merges come first: an invalid cell without a crushed edge of its own may be mended by a
 /// collapse next to it (its neighbour crosses the bisector in another cell), so its columns stop
-/// only after a round that collapsed nothing. Returns the faces whose cells changed.
+/// only after a round that merged nothing. Returns the faces whose cells changed.
 #[allow(clippy::too_many_arguments)]
 fn repair_invalid_cells(
     plan: &mut SlabPlan,
@@ -656,23 +677,7 @@ fn repair_invalid_cells(
                 changed_faces.extend(given_up);
                 continue;
             }
-            let merged =
-                entropy::collapse_crushed_edge(plan, front, f, columns, &mesh.points).or_else(|| {
-                    let invalid_cells = |plan: &SlabPlan, group: &[u32]| {
-                        invalid_cells_around(plan, reshape, mesh, columns, front, group)
-                    };
-                    let root = entropy::merge_before_crossing(
-                        plan,
-                        front,
-                        f,
-                        columns,
-                        &mesh.points,
-                        walls,
-                        &invalid_cells,
-                    )?;
-                    Some(plan.merges.group(root).collect())
-                });
-            match merged {
+            match mend_by_merge(plan, reshape, mesh, columns, front, walls, f) {
                 Some(merged) => changed.extend(merged),
                 None => uncollapsed.push(f),
             }
@@ -726,7 +731,7 @@ fn stop_face_columns(plan: &mut SlabPlan, front: &Front, columns: &Columns, f: u
 }
 
 /// Stop the fewest columns that mend invalid face `f`: one root of it (with its fan mates on a
-/// fan face), if that leaves its cell valid and no more invalid cells around; the one whose
+/// fan face), if that leaves its cell valid and fewer invalid cells around; the one whose
 /// stop holds the fewest columns. `None` when no single root does. A face whose far corner is
 /// still short of the bisector its other corners merged on needs only that corner stopped.
 fn stop_fewest_columns(
@@ -737,9 +742,7 @@ fn stop_fewest_columns(
     front: &Front,
     f: usize,
 ) -> Option<Vec<u32>> {
-    let mut roots: Vec<u32> = front.face_columns(f).iter().map(|&c| plan.merges.root(c)).collect();
-    roots.sort_unstable();
-    roots.dedup();
+    let roots = plan.merges.face_roots(front, f);
     if roots.len() < 2 {
         return None;
     }
