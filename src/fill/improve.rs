@@ -273,7 +273,7 @@ impl TetMesh {
         let [a, b, c] = key.map(|v| self.points[v as usize]);
         let normal = triangle_area_vector(a, b, c).normalize_or_zero();
         let p = self.points[apex as usize];
-        let height = (p - a).dot(normal);
+        let height = height_over([a, b, c], p);
         // Just into the band: the least move (a stretched triangle's tetrahedron as tall as
         // its layer can be a needle).
         let wanted = height.abs().clamp(h / self.band * 1.01, h * self.band / 1.01);

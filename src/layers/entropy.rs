@@ -221,10 +221,11 @@ fn crosses_bisector(
 
 /// Repair invalid face `f` by merging one of its face columns into the bisector column beside it
 /// that it will pass within [`REPAIR_ANTICIPATION`] of its last approaches (with its fan mates,
-/// if it is a fan's), if that leaves fewer invalid cells around; returns the surviving root. On a thin wall triangle along a ridge, one
-/// corner merging on time can turn the cell over while the next corner is a layer short of the
-/// bisector: merging that one early keeps the cell, where a general earlier merge would take the
-/// front off the offset elsewhere (at 1.5 approaches everywhere, the flange fell to 86.9%).
+/// if it is a fan's), if that leaves fewer invalid cells around; returns the surviving root. On a
+/// thin wall triangle along a ridge, one corner merging on time can turn the cell over while the
+/// next corner is a layer short of the bisector: merging that one early keeps the cell, where a
+/// general earlier merge would take the front off the offset elsewhere (at 1.5 approaches
+/// everywhere, the flange fell to 86.9%).
 pub(super) fn merge_before_crossing(
     plan: &mut SlabPlan,
     front: &Front,
@@ -314,10 +315,7 @@ const SLIVER: f64 = 0.2;
 /// Whether roots `v` and `w` may merge: both moving, the front stays a manifold, and they are
 /// not two columns of one fan or columns that slide differently.
 fn can_merge(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, w: u32) -> bool {
-    moving_roots(plan, v, w)
-        && !columns.is_fan_edge(v as usize, w as usize)
-        && columns.slide[v as usize] == columns.slide[w as usize]
-        && plan.merges.can_collapse(front, v, w)
+    !columns.is_fan_edge(v as usize, w as usize) && can_merge_fan_mate(plan, front, columns, v, w)
 }
 
 /// Merge root `c` into root `r`, and with it the fan mates of `c` that can follow; undo it all
@@ -330,13 +328,17 @@ fn try_collapse_with_fan_mates(
     c: u32,
     accept: &impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> Option<u32> {
+    let mut mates = Vec::new();
+    front.neighbours(c as usize, &mut mates);
+    mates.retain(|&m| columns.is_fan_edge(c as usize, m));
+    if mates.is_empty() {
+        return None;
+    }
     let saved = plan.clone();
     collapse(plan, columns, r, c);
-    let mut next = Vec::new();
-    front.neighbours(c as usize, &mut next);
-    for &m in &next {
+    for &m in &mates {
         let (root, m) = (plan.merges.root(r), m as u32);
-        if columns.is_fan_edge(c as usize, m as usize) && can_merge_fan_mate(plan, front, columns, root, m) {
+        if can_merge_fan_mate(plan, front, columns, root, m) {
             collapse(plan, columns, root, m);
         }
     }
@@ -349,8 +351,8 @@ fn try_collapse_with_fan_mates(
     None
 }
 
-/// Whether root `m`, a fan mate of a column merged into root `v`, may follow it: as
-/// [`can_merge`], but the fan edge is what joins them.
+/// Whether roots `v` and `m` may merge though a fan edge may join them (a fan mate following its
+/// column into a bisector): both moving, sliding alike, and the front stays a manifold.
 fn can_merge_fan_mate(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32, m: u32) -> bool {
     moving_roots(plan, v, m)
         && columns.slide[v as usize] == columns.slide[m as usize]

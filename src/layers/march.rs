@@ -610,13 +610,25 @@ fn invalid_cells_around(
     front: &Front,
     group: &[u32],
 ) -> usize {
-    let committed = mesh.points.len() as u32;
-    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
     front
         .faces_around_columns(group)
         .into_iter()
-        .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
+        .filter(|&f| !face_cell_is_valid(plan, reshape, mesh, columns, front, f))
         .count()
+}
+
+/// Whether the cell over face `f` is valid under `plan`.
+fn face_cell_is_valid(
+    plan: &SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    f: usize,
+) -> bool {
+    let committed = mesh.points.len() as u32;
+    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed))
 }
 
 /// Merge columns to mend the invalid cell over face `f`: its crushed edge ([`entropy::collapse_crushed_edge`]),
@@ -656,16 +668,14 @@ fn repair_invalid_cells(
     walls: &VertexWalls,
     mut to_check: Vec<usize>,
 ) -> Vec<usize> {
-    let committed = mesh.points.len() as u32;
     let mut changed_anywhere = Vec::new();
     while !to_check.is_empty() {
         let invalid: Vec<usize> = {
-            let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
             let (plan, reshape) = (&*plan, &*reshape);
             to_check
                 .par_iter()
                 .copied()
-                .filter(|&f| !proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed)))
+                .filter(|&f| !face_cell_is_valid(plan, reshape, mesh, columns, front, f))
                 .collect()
         };
         let mut changed = Vec::new();
@@ -720,14 +730,21 @@ fn repair_invalid_cells(
 /// Returns the columns whose cells change.
 fn stop_face_columns(plan: &mut SlabPlan, front: &Front, columns: &Columns, f: usize) -> Vec<u32> {
     let cols = front.face_columns(f);
-    let n = cols.len();
-    let fan_edge = |i: usize| columns.is_fan_edge(cols[i] as usize, cols[(i + 1) % n] as usize);
-    let corner_on_wall = (0..n).all(fan_edge) && cols.iter().any(|&c| columns.layers[c as usize] == 0);
+    let fan_edges = face_fan_edges(front, columns, f);
+    let corner_on_wall =
+        fan_edges.iter().all(|&e| e) && cols.iter().any(|&c| columns.layers[c as usize] == 0);
     let mut group: Vec<u32> = cols.to_vec();
-    if (0..n).any(fan_edge) && !corner_on_wall {
+    if fan_edges.contains(&true) && !corner_on_wall {
         add_fan_mates(front, columns, &mut group);
     }
     plan.stop_all(group)
+}
+
+/// Whether each edge of face `f` (from its corner `i` to the next) is a fan edge.
+fn face_fan_edges(front: &Front, columns: &Columns, f: usize) -> Vec<bool> {
+    let cols = front.face_columns(f);
+    let n = cols.len();
+    (0..n).map(|i| columns.is_fan_edge(cols[i] as usize, cols[(i + 1) % n] as usize)).collect()
 }
 
 /// Stop the fewest columns that mend invalid face `f`: one root of it (with its fan mates on a
@@ -746,11 +763,7 @@ fn stop_fewest_columns(
     if roots.len() < 2 {
         return None;
     }
-    let fan_face = {
-        let cols = front.face_columns(f);
-        (0..cols.len()).any(|i| columns.is_fan_edge(cols[i] as usize, cols[(i + 1) % cols.len()] as usize))
-    };
-    let committed = mesh.points.len() as u32;
+    let fan_face = face_fan_edges(front, columns, f).contains(&true);
     let mut best: Option<(usize, SlabPlan, Vec<u32>)> = None;
     for &r in &roots {
         let mut group = vec![r];
@@ -761,9 +774,7 @@ fn stop_fewest_columns(
         let before = invalid_cells_around(plan, reshape, mesh, columns, front, &around);
         let mut trial = plan.clone();
         let changed = trial.stop_all(group);
-        let proposal = Proposal { points: &mesh.points, proposed: &trial.proposed, committed };
-        let mended = proposal.cell_is_valid(&face_cell(front, f, &trial, reshape, columns, committed));
-        if mended
+        if face_cell_is_valid(&trial, reshape, mesh, columns, front, f)
             && invalid_cells_around(&trial, reshape, mesh, columns, front, &changed) < before
             && best.as_ref().is_none_or(|b| changed.len() < b.0)
         {
