@@ -479,8 +479,9 @@ impl std::fmt::Display for MeshReport {
                     j.histogram.iter().map(|(label, n)| format!("{label}: {n}")).collect();
                 writeln!(
                     f,
-                    "size jump first core tet over last layer height at {} front triangles: median {:.2}, within [1/r, r] at {:.1}%; {}",
+                    "size jump first core tet over last layer height at {} front triangles on prisms (of {}): median {:.2}, within [1/r, r] at {:.1}%; {}",
                     j.stats.count,
+                    j.front_triangles,
                     j.stats.median,
                     100.0 * j.stats.within_band,
                     bins.join(", ")

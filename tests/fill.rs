@@ -368,9 +368,11 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
     }
 }
 
-/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 96.9% of the front triangles'
+/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 97.4% of the front triangles'
 /// first core tetrahedra within [1/r, r] of the last layer (94.5% before the flips that match
-/// them). Its core still has tetrahedra below 10 degrees, so the angle bar is not asserted.
+/// them). Its core still has 10 tetrahedra below 10 degrees (28 before the transition stacks
+/// stepped down to their stopped neighbours), so the angle bar is not asserted, only that the
+/// steps stay mended.
 #[test]
 fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/fandisk.obj");
@@ -378,7 +380,9 @@ fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     let out = run(surface, &Config::default(), &MeshOptions { core: true }, Progress::hidden())
         .expect("fandisk meshes");
     assert!(out.report.check.is_valid(), "{}", out.report.check);
-    let jump = &out.report.core.as_ref().expect("a core").size_jump.stats;
-    eprintln!("fandisk: size jump {jump:?}");
+    let core = out.report.core.as_ref().expect("a core");
+    let jump = &core.size_jump.stats;
+    eprintln!("fandisk: size jump {jump:?}, {} slivers", core.quality.slivers.count);
+    assert!(core.quality.slivers.count <= 15, "{} tetrahedra below 10 deg", core.quality.slivers.count);
     assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
 }

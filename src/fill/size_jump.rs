@@ -3,7 +3,7 @@
 //! height of the last layer's prism under it. A smooth transition keeps the ratio within
 //! [1/r, r]; an isotropic core on thin last layers gives ratios far above r.
 
-use std::collections::HashMap;
+use std::collections::{HashMap, HashSet};
 
 use serde::Serialize;
 
@@ -14,8 +14,12 @@ use crate::mesh::{CellKind, VolumeMesh};
 /// The size-jump ratios and their histogram.
 #[derive(Clone, Debug, Default, Serialize)]
 pub struct SizeJump {
-    /// Within the band [1/r, r].
+    /// Within the band [1/r, r]; over the front triangles on a prism.
     pub stats: RatioStats,
+    /// Every front triangle (a face of a layer cell and a core tetrahedron): those on a
+    /// pyramid or a tetrahedron (where columns stopped, merged or split at the last layer) are
+    /// not measured, their cells having no one height.
+    pub front_triangles: usize,
     /// Counts per bin, the bins bounded by powers of r: (label, count).
     pub histogram: Vec<(String, usize)>,
 }
@@ -56,10 +60,13 @@ pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) 
             }
         }
     }
+    let layer_faces = layer_triangles(mesh, layer_zone, &in_core);
     let mut ratios = Vec::new();
+    let mut front_triangles = 0;
     for t in core_tets() {
         for face in CellKind::Tetrahedron.faces() {
             let [a, b, c] = [t[face[0]], t[face[1]], t[face[2]]];
+            front_triangles += usize::from(layer_faces.contains(&key([a, b, c])));
             if let Some(&h) = last_height.get(&key([a, b, c])) {
                 let x = |n: u32| mesh.points[n as usize];
                 let apex = t.iter().copied().find(|n| ![a, b, c].contains(n)).map_or(x(a), x);
@@ -67,7 +74,33 @@ pub fn measure(mesh: &VolumeMesh, layer_zone: u32, core_zone: u32, growth: f64) 
             }
         }
     }
-    SizeJump { histogram: histogram(&ratios, growth), stats: RatioStats::of(ratios, 1.0 / growth, growth) }
+    SizeJump {
+        histogram: histogram(&ratios, growth),
+        stats: RatioStats::of(ratios, 1.0 / growth, growth),
+        front_triangles,
+    }
+}
+
+/// The triangular faces (sorted nodes) of the layer cells in `layer_zone` whose nodes are all
+/// `in_core`: every front triangle is one of them.
+fn layer_triangles(mesh: &VolumeMesh, layer_zone: u32, in_core: &[bool]) -> HashSet<[u32; 3]> {
+    let mut faces = HashSet::new();
+    for kind in [CellKind::Prism, CellKind::Pyramid, CellKind::Tetrahedron] {
+        let block = mesh.block(kind);
+        for (cell, &zone) in block.nodes.chunks_exact(kind.node_count()).zip(&block.zone) {
+            if zone != layer_zone {
+                continue;
+            }
+            for face in kind.faces().iter().filter(|f| f.len() == 3) {
+                let mut t = [cell[face[0]], cell[face[1]], cell[face[2]]];
+                if t.iter().all(|&n| in_core.get(n as usize) == Some(&true)) {
+                    t.sort_unstable();
+                    faces.insert(t);
+                }
+            }
+        }
+    }
+    faces
 }
 
 /// The signed distance of `apex` from the plane of `triangle` (positive on the side its
@@ -133,5 +166,27 @@ mod tests {
         assert!((jump.stats.median - 3.0).abs() < 1e-12, "{:?}", jump.stats);
         assert_eq!(jump.stats.within_band, 0.0);
         assert_eq!(jump.histogram[5].1, 1, "{:?}", jump.histogram);
+        assert_eq!(jump.front_triangles, 1);
+    }
+
+    /// A core tetrahedron on a layer tetrahedron (a stopped or split column's cell) is a front
+    /// triangle the ratio leaves out.
+    #[test]
+    fn a_front_triangle_on_a_layer_tet_is_counted_not_measured() {
+        let mut mesh = VolumeMesh {
+            points: vec![
+                DVec3::new(0.0, 0.0, 0.0),
+                DVec3::new(1.0, 0.0, 0.0),
+                DVec3::new(0.0, 1.0, 0.0),
+                DVec3::new(0.3, 0.3, -0.5),
+                DVec3::new(0.3, 0.3, 1.0),
+            ],
+            zone_names: vec!["layers".into(), "core".into()],
+            ..Default::default()
+        };
+        mesh.push_cell(CellKind::Tetrahedron, &[0, 2, 1, 3], 0);
+        mesh.push_cell(CellKind::Tetrahedron, &[0, 1, 2, 4], 1);
+        let jump = measure(&mesh, 0, 1, 1.2);
+        assert_eq!((jump.front_triangles, jump.stats.count), (1, 0));
     }
 }

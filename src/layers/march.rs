@@ -418,14 +418,17 @@ fn stop_isotropic_columns(
     wall_size: Option<&[f64]>,
 ) {
     let size = front_sizes(&mesh.points, columns, front);
-    let ended = ended_neighbour_layers(columns, front);
+    let (ended, stopped) = ended_neighbour_layers(columns, front);
     let ends = |c: usize| {
         let (Some(d), Some(d_before)) = (columns.distance(c, k), columns.distance(c, k - 1)) else {
             return false;
         };
         // A neighbour's stack ended more than one layer lower: end here too, so that the stacks
-        // step down one layer at a time (no cliff in the final front).
-        let cliff = ended[c] < columns.layers[c];
+        // step down one layer at a time (no cliff in the final front). A full stack (in its
+        // transition layers) steps down to a stopped neighbour alike: the steps it would leave
+        // make slivers and size jumps in the core (spot: 401 -> 198 tetrahedra below 10 deg).
+        let full = columns.full_count(c).is_some_and(|n| columns.layers[c] >= n);
+        let cliff = ended[c] < columns.layers[c] || (full && stopped[c] < columns.layers[c]);
         cliff || d - d_before >= wall_size.map_or(size[c], |w| size[c].min(w[c]))
     };
     let candidates: Vec<bool> =
@@ -493,18 +496,23 @@ fn front_sizes(points: &[DVec3], columns: &Columns, front: &Front) -> Vec<f64> {
     size
 }
 
-/// For every column, the fewest layers of a neighbour (across a front edge) whose stack ended at
-/// isotropy (`u32::MAX` if none).
-fn ended_neighbour_layers(columns: &Columns, front: &Front) -> Vec<u32> {
-    let mut fewest = vec![u32::MAX; columns.len()];
+/// For every column, the fewest layers of a neighbour (across a front edge) whose stack ended:
+/// at isotropy, and stopped (early, or past its count by a crossing), a merged neighbour counted
+/// by the column it merged into (`u32::MAX` if none).
+fn ended_neighbour_layers(columns: &Columns, front: &Front) -> (Vec<u32>, Vec<u32>) {
+    let mut isotropic = vec![u32::MAX; columns.len()];
+    let mut stopped = vec![u32::MAX; columns.len()];
     for (a, b) in front.edges() {
         for (c, n) in [(a, b), (b, a)] {
+            let n = columns.carrier(n);
             if !columns.isotropic_ratio[n].is_nan() {
-                fewest[c] = fewest[c].min(columns.layers[n]);
+                isotropic[c] = isotropic[c].min(columns.layers[n]);
+            } else if !columns.alive[n] && columns.spec[n].is_some() {
+                stopped[c] = stopped[c].min(columns.layers[n]);
             }
         }
     }
-    fewest
+    (isotropic, stopped)
 }
 
 /// Where every column will be at the end of the guard's horizon: after layer `k` if the slab
