@@ -59,7 +59,12 @@ struct Proposal<'a> {
     committed: u32,
 }
 
-impl Proposal<'_> {
+impl<'a> Proposal<'a> {
+    /// The nodes of `mesh` with the tops `plan` proposes after them.
+    fn of_plan(mesh: &'a VolumeMesh, plan: &'a SlabPlan) -> Proposal<'a> {
+        Proposal { points: &mesh.points, proposed: &plan.proposed, committed: mesh.points.len() as u32 }
+    }
+
     fn position(&self, node: u32) -> DVec3 {
         match node.checked_sub(self.committed) {
             Some(c) => self.proposed[c as usize],
@@ -519,8 +524,8 @@ fn ended_neighbour_layers(columns: &Columns, front: &Front) -> (Vec<u32>, Vec<u3
 /// has merged columns (they move to other columns' positions), else after the next
 /// [`LOOKAHEAD_LAYERS`] layers if it keeps moving (or its last layer, if that comes first).
 fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach {
-    let committed = mesh.points.len() as u32;
-    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    let proposal = Proposal::of_plan(mesh, plan);
+    let committed = proposal.committed;
     if plan.collapses > 0 {
         let end =
             (0..columns.len() as u32).map(|c| proposal.position(plan.top(c, columns, committed))).collect();
@@ -634,8 +639,8 @@ fn face_cell_is_valid(
     front: &Front,
     f: usize,
 ) -> bool {
-    let committed = mesh.points.len() as u32;
-    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    let proposal = Proposal::of_plan(mesh, plan);
+    let committed = proposal.committed;
     proposal.cell_is_valid(&face_cell(front, f, plan, reshape, columns, committed))
 }
 
@@ -821,8 +826,8 @@ fn trace_invalid_cell(
     front: &Front,
     f: usize,
 ) {
-    let committed = mesh.points.len() as u32;
-    let proposal = Proposal { points: &mesh.points, proposed: &plan.proposed, committed };
+    let proposal = Proposal::of_plan(mesh, plan);
+    let committed = proposal.committed;
     let cell = face_cell(front, f, plan, reshape, columns, committed);
     let cols = front.face_columns(f);
     let nodes: Vec<(u32, DVec3)> = cols
