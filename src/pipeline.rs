@@ -460,7 +460,7 @@ impl std::fmt::Display for MeshReport {
                 )?;
                 writeln!(
                     f,
-                    "          {} seeds over the front in place (of {} front vertices with a prism under them)",
+                    "          {} seeds over the front in place (of {} front vertices with a last layer under them)",
                     c.seeds, c.seed_candidates
                 )?;
                 writeln!(
@@ -479,11 +479,14 @@ impl std::fmt::Display for MeshReport {
                     j.histogram.iter().map(|(label, n)| format!("{label}: {n}")).collect();
                 writeln!(
                     f,
-                    "size jump first core tet over last layer height at {} front triangles on prisms (of {}): median {:.2}, within [1/r, r] at {:.1}%; {}",
+                    "size jump first core tet over last layer height at {} of {} front triangles ({} sides of the layers): median {:.2}, within [1/r, r] at {:.1}% ({:.1}% of the {} on prisms); {}",
                     j.stats.count,
                     j.front_triangles,
+                    j.side_faces,
                     j.stats.median,
                     100.0 * j.stats.within_band,
+                    100.0 * j.on_prisms.within_band,
+                    j.on_prisms.count,
                     bins.join(", ")
                 )?;
             }

@@ -68,12 +68,25 @@ impl std::fmt::Display for Timings {
     }
 }
 
-/// Peak resident memory of this process so far (Linux `VmHWM`), in MiB; `None` elsewhere.
+/// Peak resident memory of this process so far (Linux `VmHWM`), or of a child process that
+/// ended if larger (the core mesher's), in MiB; `None` elsewhere.
 pub fn peak_memory_mib() -> Option<f64> {
     let status = std::fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
     let kib: f64 = line.split_whitespace().nth(1)?.parse().ok()?;
-    Some(kib / 1024.0)
+    Some(kib.max(children_peak_kib()) / 1024.0)
+}
+
+/// The largest resident set of the child processes that ended (the core mesher runs in one,
+/// see `fill::isolate`), KiB.
+fn children_peak_kib() -> f64 {
+    // SAFETY: an all-zero rusage is valid, and getrusage only writes into it.
+    let mut usage: libc::rusage = unsafe { std::mem::zeroed() };
+    // SAFETY: `usage` is valid for writes.
+    if unsafe { libc::getrusage(libc::RUSAGE_CHILDREN, &mut usage) } != 0 {
+        return 0.0;
+    }
+    usage.ru_maxrss as f64
 }
 
 #[cfg(test)]

@@ -3,8 +3,11 @@
 
 use std::collections::{HashMap, HashSet};
 
+use super::size_jump::LastLayer;
 use super::{farfield, ClosedBoundary, FarfieldSpec, FillError, CORE_ZONE_NAME, FARFIELD_PATCH};
 use super::{sorted_triangle, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
+use crate::geometry::DVec3;
+use crate::layers::march::LAYER_ZONE;
 use crate::layers::sliding::SymmetryPlane;
 use crate::layers::TOP_PATCH;
 use crate::mesh::{BoundaryFaces, CellKind, VolumeMesh};
@@ -222,25 +225,32 @@ impl CoreBuild {
 }
 
 impl CoreBuild {
-    /// The height of the prism under every boundary triangle (NaN where there is none: walls
-    /// without layers, the farfield, the pyramids' sides, and the other layer cells, whose
-    /// heights say less about the layer: a collapsed column's apex, a split cell's centre).
-    pub fn prism_heights(&self) -> Vec<f64> {
-        let index: HashMap<[u32; 3], usize> = (0..self.faces.len())
-            .filter(|&f| self.markers[f] == MARKER_FRONT)
-            .map(|f| (sorted_triangle(self.faces[f]), f))
-            .collect();
-        let mut height = vec![f64::NAN; self.faces.len()];
+    /// The last layer under the core's boundary ([`LastLayer`]), `nodes` being the mesh nodes
+    /// of the boundary points (from [`CoreBuild::closed_boundary`]). With `on_prisms_only`, the
+    /// front triangles with no prism under them get no height.
+    pub fn front_layer(&self, nodes: &[u32], on_prisms_only: bool) -> FrontLayer {
+        let last_layer = LastLayer::of(&self.mesh, LAYER_ZONE);
         let x = |n: u32| self.mesh.points[n as usize];
-        let prisms = self.mesh.block(CellKind::Prism);
-        // Every prism is a layer cell: the core adds pyramids only.
-        for p in prisms.iter() {
-            if let Some(&f) = index.get(&sorted_triangle([p[3], p[4], p[5]])) {
-                if let Ok(nodes) = <[u32; 6]>::try_from(p) {
-                    height[f] = super::size_jump::prism_height(nodes.map(x));
-                }
-            }
-        }
-        height
+        let heights = (0..self.faces.len())
+            .map(|f| {
+                let face = self.faces[f];
+                let height = (self.markers[f] == MARKER_FRONT).then(|| last_layer.height(face, face.map(x)));
+                let height = height.flatten().filter(|&(_, on_prism)| on_prism || !on_prisms_only);
+                height.map_or(f64::NAN, |(h, _)| h)
+            })
+            .collect();
+        let steps = nodes.iter().map(|&n| last_layer.step(n).unwrap_or(DVec3::NAN)).collect();
+        FrontLayer { heights, steps }
     }
+}
+
+/// The last layer under the core's boundary, for the seeds and the improvement.
+#[derive(Clone, Debug, Default)]
+pub struct FrontLayer {
+    /// The last layer's height under every boundary triangle ([`LastLayer::height`]; NaN where
+    /// there is none: walls without layers, the farfield, the pyramids' sides, front triangles
+    /// with no column's last step at a node).
+    pub heights: Vec<f64>,
+    /// The last step of the column at every boundary point (NaN where none).
+    pub steps: Vec<DVec3>,
 }

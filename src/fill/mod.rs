@@ -10,6 +10,8 @@
 pub mod farfield;
 mod front;
 pub mod improve;
+#[cfg(feature = "tetgen")]
+mod isolate;
 mod merge;
 pub mod seeds;
 pub mod size_jump;
@@ -19,6 +21,8 @@ pub mod tetgen;
 use std::time::Instant;
 
 use serde::Serialize;
+
+pub use front::FrontLayer;
 
 use crate::config::{Config, FarfieldShape, Flow};
 use crate::geometry::{triangle_area_vector, DVec3};
@@ -200,14 +204,14 @@ impl CoreGuide {
         }
     }
 
-    /// [`CoreGuide::mean_edge_length`] and the seeds over the front (`prism_height`: the height
-    /// of the prism under every boundary triangle, see [`seeds::seed_points`]). A seed and the
+    /// [`CoreGuide::mean_edge_length`] and the seeds over the front's last layer `front` (see
+    /// [`seeds::seed_points`]). A seed and the
     /// front vertex under it are sized by the larger of the front's edges and the seed's height:
     /// where the last layer is taller than the front is wide, the first core cell is too, and
     /// sized by the edges alone the mesher would split it half way up.
-    pub fn with_seeds(boundary: &ClosedBoundary, prism_height: &[f64]) -> (CoreGuide, seeds::Seeds) {
+    pub fn with_seeds(boundary: &ClosedBoundary, front: &FrontLayer) -> (CoreGuide, seeds::Seeds) {
         let mut guide = CoreGuide::mean_edge_length(boundary);
-        let seeds = seeds::seed_points(boundary, prism_height, &guide.size);
+        let seeds = seeds::seed_points(boundary, front, &guide.size);
         guide.interior = seeds.points.clone();
         let mut seed_sizes = Vec::with_capacity(seeds.vertex.len());
         for (&v, &h) in seeds.vertex.iter().zip(&seeds.height) {
@@ -256,6 +260,11 @@ pub enum FillError {
     Input(String),
     #[error("TetGen failed (code {code}): {message}")]
     TetGen { code: i32, message: String },
+    #[error(
+        "TetGen crashed (signal {signal}; it aborts when an internal assertion fails, as TetGen 1.5 \
+         can on points inserted very near each other or near the boundary)"
+    )]
+    TetGenCrashed { signal: i32 },
     #[error("the mesher returned a broken mesh: {0}")]
     BadOutput(String),
     #[error(
@@ -320,7 +329,7 @@ pub struct CoreStats {
     /// Pyramids put on the quads of the front.
     pub pyramids: usize,
     /// Points inside the core: all of them (the seeds included), and the seeds over the front
-    /// the mesher kept in place, of the candidates (front vertices with a prism under them).
+    /// the mesher kept in place, of the candidates (front vertices with a last layer under them).
     pub steiner_points: usize,
     pub seeds: usize,
     pub seed_candidates: usize,
@@ -404,18 +413,19 @@ pub fn fill_core_with_symmetry(
         (None, None) => {}
     }
     let (boundary, nodes) = core.closed_boundary();
-    let prism_heights = core.prism_heights();
-    let (guide, seeds) = if options.seed_front {
-        CoreGuide::with_seeds(&boundary, &prism_heights)
-    } else {
-        (CoreGuide::mean_edge_length(&boundary), seeds::Seeds::default())
-    };
+    let front_layer = core.front_layer(&nodes, false);
     let mesher_start = Instant::now();
-    let (tets, seeds_used) = fill_keeping_boundary(mesher, &boundary, guide)?;
+    let (tets, seeds_used, seeds) = if options.seed_front {
+        fill_with_seeds(mesher, &boundary, &front_layer, || core.front_layer(&nodes, true))?
+    } else {
+        let (tets, _) = fill_keeping_boundary(mesher, &boundary, CoreGuide::mean_edge_length(&boundary))?;
+        (tets, 0, seeds::Seeds::default())
+    };
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     // The seeds stay where they are: they give the first core cells the last layer's height.
     let fixed = boundary.points.len() + seeds_used;
-    let (tets, quality) = improve::improve_core(&boundary, tets, fixed, &prism_heights, &options.improve);
+    let (tets, quality) =
+        improve::improve_core(&boundary, tets, fixed, &front_layer.heights, &options.improve);
     merge::check_boundary_kept(&boundary, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
     stats.quality = quality;
@@ -425,6 +435,32 @@ pub fn fill_core_with_symmetry(
     stats.mesher_seconds = mesher_seconds;
     stats.seconds = start.elapsed().as_secs_f64();
     Ok((mesh, stats))
+}
+
+/// Run the mesher with the seeds over the front's last layer `front`; when it crashes on them
+/// (TetGen aborts on a failed assertion, seen on the ONERA M6 with seeds over the ramps between
+/// stacks), again with the seeds over the prisms only (`on_prisms`), then with none. Returns
+/// the tetrahedra, the seeds in place and the seeds given.
+fn fill_with_seeds(
+    mesher: &dyn CoreMesher,
+    boundary: &ClosedBoundary,
+    front: &FrontLayer,
+    on_prisms: impl FnOnce() -> FrontLayer,
+) -> Result<(CoreTets, usize, seeds::Seeds), FillError> {
+    let (guide, seeds) = CoreGuide::with_seeds(boundary, front);
+    let signal = match fill_keeping_boundary(mesher, boundary, guide) {
+        Err(FillError::TetGenCrashed { signal }) => signal,
+        result => return result.map(|(tets, used)| (tets, used, seeds)),
+    };
+    tracing::warn!(signal, "TetGen crashed: again with the seeds over the prisms only");
+    let (guide, seeds) = CoreGuide::with_seeds(boundary, &on_prisms());
+    let signal = match fill_keeping_boundary(mesher, boundary, guide) {
+        Err(FillError::TetGenCrashed { signal }) => signal,
+        result => return result.map(|(tets, used)| (tets, used, seeds)),
+    };
+    tracing::warn!(signal, "TetGen crashed: again without seeds");
+    let (tets, _) = fill_keeping_boundary(mesher, boundary, CoreGuide::mean_edge_length(boundary))?;
+    Ok((tets, 0, seeds::Seeds { candidates: seeds.candidates, ..Default::default() }))
 }
 
 /// Times the mesher is run again, with the seeds near the boundary triangle it lost removed,

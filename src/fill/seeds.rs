@@ -1,5 +1,6 @@
 //! The first core points above the front (issue 5, no size jump at the layer top): a point over
-//! every front vertex, along the front's normal, at the height of the last layer under it.
+//! every front vertex at the height of the last layer under it, on the column's way (one more
+//! step of it) where the vertex tops a column's prisms, else along the front's normal.
 //! Left to itself, the mesher's Delaunay refinement puts the fourth node of the tetrahedron on a
 //! front triangle wherever its radius-edge rule lands it (about 0.7 of the last layer height on
 //! fandisk and the Onera M6); with a point above every vertex, that node is one of them and the
@@ -10,7 +11,7 @@
 //! is close (two fronts facing each other across a gap, or a concave fold of the front, would
 //! put seeds on top of each other).
 
-use super::{ClosedBoundary, MARKER_FRONT};
+use super::{ClosedBoundary, FrontLayer, MARKER_FRONT};
 use crate::geometry::bvh::{box_distance_squared, TriangleBvh};
 use crate::geometry::intersect::segment_triangle;
 use crate::geometry::{triangle_area_vector, Aabb, DVec3};
@@ -42,16 +43,15 @@ pub struct Seeds {
     pub vertex: Vec<u32>,
     /// Every seed's height over the front.
     pub height: Vec<f64>,
-    /// Front vertices with a prism under them and a normal their triangles face (the
+    /// Front vertices with a last layer under them and a normal their triangles face (the
     /// candidates).
     pub candidates: usize,
 }
 
-/// The seeds over the front of `boundary`. `prism_height[t]` is the height of the prism under
-/// boundary triangle `t` (NaN where there is none); `size[v]` is the tangential size at
-/// boundary point `v`.
-pub fn seed_points(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]) -> Seeds {
-    let candidates = candidates(boundary, prism_height, size);
+/// The seeds over the front of `boundary`, whose last layer is `front`; `size[v]` is the
+/// tangential size at boundary point `v`.
+pub fn seed_points(boundary: &ClosedBoundary, front: &FrontLayer, size: &[f64]) -> Seeds {
+    let candidates = candidates(boundary, front, size);
     let bvh =
         TriangleBvh::new(boundary.triangles.iter().map(|t| t.map(|v| boundary.points[v as usize])).collect());
     let clear: Vec<Candidate> = candidates
@@ -94,10 +94,10 @@ struct Candidate {
     height: f64,
 }
 
-/// One candidate over every vertex whose triangles are all on the front, with a prism under at
-/// least one, and whose normal the triangles around it all face. Its height is the mean height
-/// of those prisms, weighed by area.
-fn candidates(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]) -> Vec<Candidate> {
+/// One candidate over every vertex whose triangles are all on the front, with a last layer's
+/// height under at least one, and whose normal the triangles around it all face. Its height is
+/// the mean of those heights, weighed by area.
+fn candidates(boundary: &ClosedBoundary, front: &FrontLayer, size: &[f64]) -> Vec<Candidate> {
     let n = boundary.points.len();
     let (mut normal, mut height, mut area) = (vec![DVec3::ZERO; n], vec![0.0; n], vec![0.0; n]);
     let mut normal_area = vec![0.0; n];
@@ -105,7 +105,7 @@ fn candidates(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]) -> 
     for (t, tri) in boundary.triangles.iter().enumerate() {
         let [a, b, c] = tri.map(|v| boundary.points[v as usize]);
         let w = triangle_area_vector(a, b, c);
-        let h = prism_height.get(t).copied().unwrap_or(f64::NAN);
+        let h = front.heights.get(t).copied().unwrap_or(f64::NAN);
         for &v in tri {
             let v = v as usize;
             on_front[v] &= boundary.markers[t] == MARKER_FRONT;
@@ -138,7 +138,11 @@ fn candidates(boundary: &ClosedBoundary, prism_height: &[f64], size: &[f64]) -> 
             // Where the front bends, the triangles around see a seed on the vertex's normal
             // lower by their cosine: raise it so that they see it at `h` on the mean (at a
             // convex crease, the mitred offset).
-            let point = boundary.points[v] + normal[v].normalize() * (h / cosine[v]);
+            let normal = normal[v].normalize();
+            let along =
+                front.steps.get(v).map(|s| s.normalize()).filter(|s| s.dot(normal) >= MIN_NORMAL_COSINE);
+            let way = along.unwrap_or(normal);
+            let point = boundary.points[v] + way * (h / cosine[v] / way.dot(normal));
             Candidate { vertex: v as u32, point, height: h }
         })
         .filter(|c| c.point.is_finite())
@@ -207,7 +211,7 @@ mod tests {
     /// A flat square front of 2 x 2 cells (unit edges, facing +z) closed by a box far above:
     /// the inner vertex gets its seed at the layer height, straight above; the rim vertices
     /// touch the box's walls (marked wall), so they get none.
-    fn plate(layer: f64) -> (ClosedBoundary, Vec<f64>) {
+    fn plate(layer: f64) -> (ClosedBoundary, FrontLayer) {
         let mut points = Vec::new();
         for j in 0..3 {
             for i in 0..3 {
@@ -234,7 +238,8 @@ mod tests {
         }
         let mut heights = vec![layer; n];
         heights.resize(triangles.len(), f64::NAN);
-        (ClosedBoundary { points, triangles, markers }, heights)
+        let steps = vec![DVec3::NAN; points.len()];
+        (ClosedBoundary { points, triangles, markers }, FrontLayer { heights, steps })
     }
 
     #[test]
@@ -245,6 +250,18 @@ mod tests {
         assert_eq!(seeds.vertex, vec![4], "{seeds:?}");
         let p = seeds.points[0];
         assert!((p - DVec3::new(1.0, 1.0, 0.9)).length() < 1e-12, "{p:?}");
+    }
+
+    /// The column under the inner vertex leans (its last step 0.9 up and 0.3 along x): the seed
+    /// goes on along it, still at the layer's height over the front.
+    #[test]
+    fn a_seed_goes_on_along_the_last_step_of_its_column() {
+        let (boundary, mut front) = plate(0.9);
+        front.steps[4] = DVec3::new(0.3, 0.0, 0.9);
+        let size = crate::sizing::wall::mean_edge_length_per_vertex(&boundary.points, &boundary.triangles);
+        let seeds = seed_points(&boundary, &front, &size);
+        let p = seeds.points[0];
+        assert!((p - DVec3::new(1.3, 1.0, 0.9)).length() < 1e-12, "{p:?}");
     }
 
     #[test]
@@ -267,7 +284,8 @@ mod tests {
         ]);
         boundary.triangles.push([base, base + 2, base + 1]);
         boundary.markers.push(super::super::MARKER_WALL);
-        heights.push(f64::NAN);
+        heights.heights.push(f64::NAN);
+        heights.steps.extend([DVec3::NAN; 3]);
         let size = vec![1.0; boundary.points.len()];
         assert!(seed_points(&boundary, &heights, &size).points.is_empty());
     }

@@ -16,10 +16,15 @@
 //!
 //! Hole points (`holelist`) inside the body shells make TetGen carve the body's interior.
 //! TetGen keeps global state, so calls are serialised.
+//!
+//! TetGen runs in a forked child process ([`run`]): it ends on a failed internal assertion
+//! (`abort`), which seen from here is a crash of the whole program. In a child, it is an error
+//! the fill can answer (by meshing again without its seeds).
 
 use std::ffi::{c_char, c_int, CString};
 use std::sync::Mutex;
 
+use super::isolate::{in_child, ChildEnd};
 use super::{ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
@@ -224,11 +229,100 @@ impl Drop for ResultGuard {
     }
 }
 
+/// Run TetGen on `input` in a forked child process ([`in_child`]): an abort or a crash of
+/// TetGen becomes [`FillError::TetGenCrashed`]. Where no child can be started, here.
 fn run(input: &Input, switches: &str) -> Result<Output, FillError> {
+    let _one_at_a_time = TETGEN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    match in_child(|| encode(&run_here(input, switches))) {
+        Ok(bytes) => decode(&bytes).unwrap_or_else(|| {
+            Err(FillError::BadOutput(format!(
+                "TetGen's process answered {} bytes that do not decode",
+                bytes.len()
+            )))
+        }),
+        Err(ChildEnd::Signal(signal)) => Err(FillError::TetGenCrashed { signal }),
+        Err(ChildEnd::Exit(status)) => {
+            Err(FillError::BadOutput(format!("TetGen's process exited with status {status} and no answer")))
+        }
+        Err(ChildEnd::NotStarted) => run_here(input, switches),
+    }
+}
+
+/// TetGen's result as bytes for the pipe: a tag (0 output, 1 error), then the counts and
+/// arrays (little-endian), or the error's code and message.
+fn encode(result: &Result<Output, FillError>) -> Vec<u8> {
+    let mut bytes = Vec::new();
+    match result {
+        Ok(out) => {
+            bytes.push(0);
+            for n in [out.points.len(), out.tets.len(), out.boundary_triangles.len()] {
+                bytes.extend((n as u64).to_le_bytes());
+            }
+            bytes.extend(out.points.iter().flat_map(|p| p.to_array()).flat_map(f64::to_le_bytes));
+            bytes.extend(out.tets.iter().flatten().flat_map(|v| v.to_le_bytes()));
+            bytes.extend(out.boundary_triangles.iter().flatten().flat_map(|v| v.to_le_bytes()));
+        }
+        Err(error) => {
+            let (code, message) = match error {
+                FillError::TetGen { code, message } => (*code, message.clone()),
+                other => (-1, other.to_string()),
+            };
+            bytes.push(1);
+            bytes.extend(code.to_le_bytes());
+            bytes.extend(message.as_bytes());
+        }
+    }
+    bytes
+}
+
+/// The result [`encode`] wrote; `None` when the bytes are not a whole one.
+fn decode(bytes: &[u8]) -> Option<Result<Output, FillError>> {
+    let (&tag, rest) = bytes.split_first()?;
+    if tag == 1 {
+        let code = i32::from_le_bytes(rest.get(..4)?.try_into().ok()?);
+        let message = String::from_utf8_lossy(rest.get(4..)?).into_owned();
+        return Some(Err(FillError::TetGen { code, message }));
+    }
+    let mut bytes = Bytes(rest);
+    let (n_points, n_tets, n_triangles) = (bytes.count()?, bytes.count()?, bytes.count()?);
+    let coordinates: Vec<f64> = bytes
+        .take(n_points.checked_mul(24)?)?
+        .chunks_exact(8)
+        .map(|c| f64::from_le_bytes(c.try_into().unwrap_or_default()))
+        .collect();
+    let points = coordinates.chunks_exact(3).map(|p| DVec3::new(p[0], p[1], p[2])).collect();
+    let tets =
+        bytes.ints(n_tets.checked_mul(4)?)?.chunks_exact(4).map(|t| [t[0], t[1], t[2], t[3]]).collect();
+    let boundary_triangles =
+        bytes.ints(n_triangles.checked_mul(3)?)?.chunks_exact(3).map(|t| [t[0], t[1], t[2]]).collect();
+    bytes.0.is_empty().then_some(Ok(Output { points, tets, boundary_triangles }))
+}
+
+/// The bytes of [`decode`] not read yet.
+struct Bytes<'a>(&'a [u8]);
+
+impl<'a> Bytes<'a> {
+    fn take(&mut self, n: usize) -> Option<&'a [u8]> {
+        let (head, tail) = self.0.split_at_checked(n)?;
+        self.0 = tail;
+        Some(head)
+    }
+
+    fn count(&mut self) -> Option<usize> {
+        usize::try_from(u64::from_le_bytes(self.take(8)?.try_into().ok()?)).ok()
+    }
+
+    fn ints(&mut self, n: usize) -> Option<Vec<c_int>> {
+        let bytes = self.take(n.checked_mul(4)?)?;
+        Some(bytes.chunks_exact(4).map(|c| c_int::from_le_bytes(c.try_into().unwrap_or_default())).collect())
+    }
+}
+
+/// Run TetGen in this process (the lock held by the caller).
+fn run_here(input: &Input, switches: &str) -> Result<Output, FillError> {
     let switches = CString::new(switches).map_err(|_| FillError::Input("switches contain a NUL".into()))?;
     let mut result: *mut ffi::BlmeshTetgenResult = std::ptr::null_mut();
     let mut message = [0 as c_char; 256];
-    let _one_at_a_time = TETGEN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
     // SAFETY: every array holds the counts passed with it (checked to fit c_int in Input::new;
     // triangle indices are < n_points); `sizes` is null or n_points long; `holes` holds 3 values
     // per hole; the strings are NUL-terminated and `message` has the capacity passed. The shim
@@ -294,6 +388,27 @@ fn tetgen_error(code: c_int, message: &[c_char]) -> FillError {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_answer_crosses_the_pipe_whole() {
+        let output = Output {
+            points: vec![DVec3::new(1.0, -2.5, 3.25), DVec3::new(f64::MIN_POSITIVE, 0.0, 1e300)],
+            tets: vec![[0, 1, 2, 3], [4, 5, 6, 7]],
+            boundary_triangles: vec![[0, 1, 2]],
+        };
+        let Some(Ok(back)) = decode(&encode(&Ok(output))) else { panic!("no output") };
+        assert_eq!(back.points, vec![DVec3::new(1.0, -2.5, 3.25), DVec3::new(f64::MIN_POSITIVE, 0.0, 1e300)]);
+        assert_eq!(
+            (back.tets.len(), back.tets[1], back.boundary_triangles),
+            (2, [4, 5, 6, 7], vec![[0, 1, 2]])
+        );
+        let error = FillError::TetGen { code: 3, message: "self-intersection".into() };
+        let Some(Err(FillError::TetGen { code, message })) = decode(&encode(&Err(error))) else { panic!() };
+        assert_eq!((code, message.as_str()), (3, "self-intersection"));
+        let whole =
+            encode(&Ok(Output { points: vec![DVec3::ONE], tets: vec![], boundary_triangles: vec![] }));
+        assert!(decode(&whole[..whole.len() - 1]).is_none(), "a truncated answer is not one");
+    }
 
     #[test]
     fn switches_keep_the_boundary_and_bound_the_quality() {
