@@ -509,7 +509,7 @@ impl TetMesh {
     /// circumsphere holds `p`, grown from the one holding it (found by walking from `start`)
     /// across interior faces, are replaced by the cone from the new point over their boundary
     /// (Bowyer-Watson). `None` when `p` is outside the region or the cone is not positive.
-    pub fn insert_point(&self, start: u32, p: DVec3) -> Option<Change> {
+    pub fn insert_point(&self, start: u32, p: DVec3, placement: Placement) -> Option<Change> {
         let first = self.locate(start, p)?;
         // The tetrahedron to improve goes too, whether or not its circumsphere holds `p`.
         let mut cavity = vec![first];
@@ -537,7 +537,10 @@ impl TetMesh {
                 }
             }
         }
-        let (position, _) = self.best_position(&add, v, p);
+        let position = match placement {
+            Placement::Best => self.best_position(&add, v, p).0,
+            Placement::AsGiven => p,
+        };
         let new_volume: f64 = add.iter().map(|t| self.volume_at(*t, v, position)).sum();
         let old_volume: f64 =
             cavity.iter().map(|&t| self.volume_at(self.tets[t as usize], v, position)).sum();
@@ -589,19 +592,24 @@ impl TetMesh {
         circumcentre(x).is_some_and(|centre| (p - centre).length_squared() < (x[0] - centre).length_squared())
     }
 
-    /// Where to insert a point for tetrahedron `t`: the best apex over each of its boundary
-    /// faces, and its circumcentre.
-    fn insertion_points(&self, t: u32) -> Vec<DVec3> {
-        let mut points: Vec<DVec3> = self
-            .outward_faces(t)
-            .into_iter()
-            .filter(|&face| self.neighbour(t, face).is_none())
-            .map(|f| {
-                let [a, b, c] = f.map(|v| self.points[v as usize]);
-                best_apex(a, c, b).0
-            })
-            .collect();
-        points.extend(circumcentre(self.corners(self.tets[t as usize])));
+    /// Where to insert a point for tetrahedron `t`: over each of its boundary faces the best
+    /// apex and, on a front triangle with a last layer under it, the point at that layer's
+    /// height over its centre; and its circumcentre. With each, whether the point is to stay
+    /// where it is (a matched apex moved to the best place would sink towards the front).
+    fn insertion_points(&self, t: u32) -> Vec<(DVec3, Placement)> {
+        let mut points = Vec::new();
+        for face in self.outward_faces(t) {
+            if self.neighbour(t, face).is_some() {
+                continue;
+            }
+            let [a, b, c] = face.map(|v| self.points[v as usize]);
+            points.push((best_apex(a, c, b).0, Placement::Best));
+            if let Some(&h) = self.front_height.get(&sorted_triangle(face)) {
+                let inward = triangle_area_vector(a, c, b).normalize_or_zero();
+                points.push(((a + b + c) / 3.0 + h * inward, Placement::AsGiven));
+            }
+        }
+        points.extend(circumcentre(self.corners(self.tets[t as usize])).map(|p| (p, Placement::Best)));
         points
     }
 
@@ -670,6 +678,22 @@ impl TetMesh {
         (direction != DVec3::ZERO && direction.is_finite()).then_some(direction)
     }
 
+    /// Of the changes that improve by `rule`, the best: one that mends the sliver (leaves no
+    /// angle below [`SLIVER_THRESHOLD`]) first, then one that leaves the most first core cells
+    /// in the band of their last layer, then the one that raises the worst angle most.
+    fn best_improving(&self, changes: Vec<Change>, rule: Rule) -> Option<Change> {
+        let key = |c: &Change| {
+            let matches = if self.front_height.is_empty() { 0 } else { self.mismatch_gain(c) };
+            (c.after >= SLIVER_THRESHOLD, matches)
+        };
+        changes
+            .into_iter()
+            .filter(|c| c.improves(rule))
+            .map(|c| (key(&c), c))
+            .max_by(|(kx, x), (ky, y)| kx.cmp(ky).then(x.after.total_cmp(&y.after)))
+            .map(|(_, c)| c)
+    }
+
     /// The change the operators propose for tetrahedron `t`: the best flip, else the best
     /// smoothing of one of its points, else the best point insertion, if one helps.
     fn improve_tet(
@@ -688,7 +712,7 @@ impl TetMesh {
                 .iter()
                 .filter_map(|f| self.flip_23([tet[f[0]], tet[f[1]], tet[f[2]]])),
         );
-        if let Some(change) = best_improving(flips, rule) {
+        if let Some(change) = self.best_improving(flips, rule) {
             match (change.remove.len(), change.add.len()) {
                 (2, 3) => stats.flips_23 += 1,
                 (3, 2) => stats.flips_32 += 1,
@@ -698,7 +722,7 @@ impl TetMesh {
             return Some(change);
         }
         let smoothing = tet.iter().filter_map(|&v| self.smooth_vertex(v)).collect();
-        if let Some(change) = best_improving(smoothing, rule) {
+        if let Some(change) = self.best_improving(smoothing, rule) {
             stats.smoothed_points += 1;
             return Some(change);
         }
@@ -708,13 +732,14 @@ impl TetMesh {
         }
         let mut insertions: Vec<Change> =
             TET_EDGES.iter().filter_map(|&(i, j)| self.split_edge(tet[i], tet[j])).collect();
-        insertions.extend(self.insertion_points(t).into_iter().filter_map(|p| self.insert_point(t, p)));
+        let points = self.insertion_points(t);
+        insertions.extend(points.iter().filter_map(|&(p, placement)| self.insert_point(t, p, placement)));
         // Nearer the tetrahedron, the cavity is smaller and more often star-shaped.
         let centre = self.corners(tet).iter().sum::<DVec3>() / 4.0;
         insertions.extend(
-            self.insertion_points(t).into_iter().filter_map(|p| self.insert_point(t, 0.5 * (p + centre))),
+            points.iter().filter_map(|&(p, _)| self.insert_point(t, 0.5 * (p + centre), Placement::Best)),
         );
-        let change = best_improving(insertions, rule)?;
+        let change = self.best_improving(insertions, rule)?;
         stats.inserted_points += 1;
         Some(change)
     }
@@ -738,6 +763,11 @@ impl TetMesh {
             options.target_dihedral.min(SLIVER_THRESHOLD),
             &mut stats,
         );
+        // The points the passes added to mend slivers low over the front go up into the band
+        // where they can.
+        if options.passes > 0 {
+            stats.front_matches += self.match_front();
+        }
         stats.seconds = start.elapsed().as_secs_f64();
         stats
     }
@@ -805,9 +835,13 @@ fn circumcentre([a, b, c, d]: [DVec3; 4]) -> Option<DVec3> {
     (denominator != 0.0 && centre.is_finite()).then_some(a + centre)
 }
 
-/// The change that raises the worst angle most, if any does by the rule.
-fn best_improving(changes: Vec<Change>, rule: Rule) -> Option<Change> {
-    changes.into_iter().filter(|c| c.improves(rule)).max_by(|x, y| x.after.total_cmp(&y.after))
+/// Where an inserted point goes.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Placement {
+    /// Where the worst of its tetrahedra is best ([`TetMesh::best_position`]).
+    Best,
+    /// Where it was given.
+    AsGiven,
 }
 
 /// When a change is an improvement.

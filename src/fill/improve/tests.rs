@@ -305,3 +305,20 @@ fn an_added_apex_too_low_for_the_last_layer_moves_into_its_band() {
     assert!((apex.z - 1.01 / 1.2).abs() < 1e-12, "just into the band: {apex}");
     assert_eq!((apex.x, apex.y), (0.3, 0.3), "along the normal");
 }
+
+/// Of two changes that both mend a sliver on a front triangle, the one that leaves its first
+/// core cell in the band of the last layer wins over a better-shaped one that does not: the
+/// apex at 1.0 (the layer's height) over 0.8 (the regular tetrahedron's, below 1/1.2).
+#[test]
+fn mending_a_sliver_keeps_the_first_core_cell_on_the_last_layer_height() {
+    let s = 3f64.sqrt();
+    let apex = |z: f64| DVec3::new(0.5, s / 6.0, z);
+    let points = vec![DVec3::ZERO, DVec3::X, DVec3::new(0.5, s / 2.0, 0.0), apex(0.05)];
+    let mut mesh = TetMesh::new(points, vec![[0, 1, 2, 3]], 3);
+    mesh.keep_front_match(HashMap::from([([0, 1, 2], 1.0)]), 1.2);
+    let raise = |z: f64| mesh.change(vec![0], vec![[0, 1, 2, 3]], Some((3, apex(z)))).expect("positive");
+    let (regular, matched) = (raise(0.8), raise(1.0));
+    assert!(regular.after > matched.after && matched.after >= SLIVER_THRESHOLD);
+    let best = mesh.best_improving(vec![regular, matched], Rule::FewerBad).expect("both improve");
+    assert_eq!(best.point.map(|p| p.1.z), Some(1.0));
+}
