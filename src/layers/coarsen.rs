@@ -26,19 +26,21 @@ pub const COLLAPSE_LENGTH: f64 = FRAC_1_SQRT_2;
 /// Rounds of collapses in one slab.
 pub const MAX_ROUNDS: usize = 3;
 
-/// Collapse the plan's short front edges against the tangential sizes `h` at the columns'
-/// proposed tops; `cells_valid(plan, group)` tells whether every cell around the columns
-/// `group` is valid under the plan. Returns how many edges collapsed.
+/// Collapse the plan's short front edges of layer `k` against the tangential sizes `h` at the
+/// columns' proposed tops (and the layer's height, within the user's sizes `user`);
+/// `cells_valid(plan, group)` tells whether every cell around the columns `group` is valid
+/// under the plan. Returns how many edges collapsed.
 pub(super) fn collapse_short_edges(
     plan: &mut SlabPlan,
     front: &Front,
     columns: &Columns,
-    h: &[f64],
+    (h, user, k): (&[f64], &[f64], u32),
     cells_valid: impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> usize {
+    let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
     let mut made = 0;
     for _ in 0..MAX_ROUNDS {
-        let mut short = short_edges(plan, front, columns, h);
+        let mut short = short_edges(plan, front, columns, [h, &height, user]);
         short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         let mut touched = vec![false; columns.len()];
         let before = made;
@@ -60,9 +62,15 @@ pub(super) fn collapse_short_edges(
 }
 
 /// The front edges `(length, a, b)` between two moving roots (after the merges so far) that are
-/// shorter than [`COLLAPSE_LENGTH`] against the target sizes `h`, each once; fan edges and edges
-/// between columns that slide differently are left out.
-fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, h: &[f64]) -> Vec<(f64, u32, u32)> {
+/// shorter than [`COLLAPSE_LENGTH`] against the sizes `[target, layer height, user]`
+/// ([`Sizes::collapse_length`]), each once; fan edges and edges between columns that slide
+/// differently are left out.
+fn short_edges(
+    plan: &SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    sizes: [&[f64]; 3],
+) -> Vec<(f64, u32, u32)> {
     let root = |c: usize| plan.merges.root(c as u32) as usize;
     let mut edges: Vec<(usize, usize)> =
         front.edges().map(|(a, b)| (root(a), root(b))).filter(|&(a, b)| a < b).collect();
@@ -73,7 +81,7 @@ fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, h: &[f64]) -> 
         .filter(|&(a, b)| plan.moving[a] && plan.moving[b])
         .filter(|&(a, b)| !columns.is_fan_edge(a, b) && columns.slide[a] == columns.slide[b])
         .filter_map(|(a, b)| {
-            let length = Sizes::collapse_length(columns, h, a, b, plan.proposed[b] - plan.proposed[a]);
+            let length = Sizes::collapse_length(columns, sizes, a, b, plan.proposed[b] - plan.proposed[a]);
             (length < COLLAPSE_LENGTH).then_some((length, a as u32, b as u32))
         })
         .collect()

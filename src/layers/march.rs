@@ -577,8 +577,10 @@ fn settle_slab(
         let invalid_cells =
             |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
         if !matches!(sizes.adapt, Adapt::Off) {
+            let user = sizes.user(&plan.proposed, &columns.alive);
+            let limits = (&reshape.target[..], &user[..], k);
             plan.coarsened =
-                coarsen::collapse_short_edges(&mut plan, front, columns, &reshape.target, |plan, group| {
+                coarsen::collapse_short_edges(&mut plan, front, columns, limits, |plan, group| {
                     invalid_cells(plan, group) == 0
                 });
         }

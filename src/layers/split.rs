@@ -45,6 +45,13 @@ pub const SPLIT_LENGTH: f64 = SQRT_2;
 /// 0.923 / 0.909 / 0.835.
 pub const COMPRESSED: f64 = 0.5;
 
+/// A front edge this many times shorter than its layer is high is collapsed
+/// ([`Sizes::collapse_length`]). At 2, the ONERA M6's wing-tip cap (facets of 0.2-0.4 under a
+/// first layer of 1.67) coarsens: 574 core slivers -> 114, and the first core cells match the
+/// last layer at 99.0% of the front triangles (94.9% before); at 1.4, 58 slivers but the box's
+/// transition layers coarsen too (94.9% -> 93.5%).
+pub const TALLEST_CELL: f64 = 2.0;
+
 /// No split (in the per-edge split lists of a face).
 pub const NONE: u32 = u32::MAX;
 
@@ -131,10 +138,21 @@ impl<'a> Sizes<'a> {
 
     /// Length of front edge `e` between columns `a` and `b` against the size it is collapsed
     /// at: the target `h`, or [`COMPRESSED`] times the edge's length on the wall where that is
-    /// shorter.
-    pub fn collapse_length(columns: &Columns, h: &[f64], a: usize, b: usize, e: DVec3) -> f64 {
+    /// shorter; but an edge [`TALLEST_CELL`] times shorter than the layer's height `height` is
+    /// collapsed anyway (not coarser than the user's size `user`, though): a front finer than
+    /// its layers are high (a wall faceted finer than the first layer, as at a wing tip) makes
+    /// needles, and coarsens whether it compressed or not.
+    pub fn collapse_length(
+        columns: &Columns,
+        [h, height, user]: [&[f64]; 3],
+        a: usize,
+        b: usize,
+        e: DVec3,
+    ) -> f64 {
         let on_wall = columns.wall_edge_length(a, b).map_or(f64::INFINITY, |w| COMPRESSED * w);
-        e.length() / mean_size(h, a, b).min(on_wall)
+        // Collapsed below 1/sqrt 2 of this size: once the layer is TALLEST_CELL times its width.
+        let by_height = mean_size(height, a, b) * std::f64::consts::SQRT_2 / TALLEST_CELL;
+        e.length() / mean_size(h, a, b).min(on_wall).max(by_height.min(mean_size(user, a, b)))
     }
 
     /// The length in the sizes of every edge of the raised front (zero-length edges left out),
