@@ -264,3 +264,45 @@ fn seeds_still_in_place_come_first_after_the_boundary() {
     let after: Vec<[DVec3; 4]> = core.tets.iter().map(|t| t.map(|v| core.points[v as usize])).collect();
     assert_eq!(before, after, "the tetrahedra keep their corners");
 }
+
+/// A mesher that crashes (as TetGen aborts on some seed sets) whenever it is given seeds, else
+/// is TetGen; it counts its runs.
+#[cfg(feature = "tetgen")]
+struct CrashesOnSeeds {
+    runs: std::cell::Cell<usize>,
+}
+
+#[cfg(feature = "tetgen")]
+impl CoreMesher for CrashesOnSeeds {
+    fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError> {
+        self.runs.set(self.runs.get() + 1);
+        if !guide.interior.is_empty() {
+            return Err(FillError::TetGenCrashed { signal: 6 });
+        }
+        tetgen::TetGen::default().fill(boundary, guide)
+    }
+}
+
+/// A cube (its faces the front, a last layer 0.1 under each) in a box farfield.
+#[cfg(feature = "tetgen")]
+#[test]
+fn a_mesher_crashing_on_the_seeds_is_run_again_with_fewer_then_none() {
+    let cube = shapes::cuboid(DVec3::splat(1.0), 4);
+    let mut boundary = boundary_of(&cube);
+    boundary.markers = vec![MARKER_FRONT; cube.triangles.len()];
+    let far = farfield::farfield(&FarfieldSpec::default(), cube.bounding_box()).unwrap();
+    let offset = boundary.points.len() as u32;
+    boundary.points.extend(far.points);
+    boundary.triangles.extend(far.triangles.iter().map(|t| t.map(|v| v + offset)));
+    boundary.markers.resize(boundary.triangles.len(), MARKER_FARFIELD);
+    let mut heights = vec![0.1; cube.triangles.len()];
+    heights.resize(boundary.triangles.len(), f64::NAN);
+    let front = FrontLayer { heights, steps: vec![DVec3::NAN; boundary.points.len()] };
+    assert!(!CoreGuide::with_seeds(&boundary, &front).1.points.is_empty(), "there are seeds to crash on");
+    let mesher = CrashesOnSeeds { runs: std::cell::Cell::new(0) };
+    let (tets, used, seeds) =
+        fill_with_seeds(&mesher, &boundary, &front, || front.clone()).expect("no seeds at last");
+    assert_eq!((used, seeds.points.len(), mesher.runs.get()), (0, 0, 3));
+    assert!(seeds.candidates > 0, "the candidates are still reported");
+    merge::check_boundary_kept(&boundary, &tets).expect("a whole fill");
+}
