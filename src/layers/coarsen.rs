@@ -1,6 +1,6 @@
 //! Tangential collapse of short front edges (issue 4, DESIGN.md "Tangential adaptivity"): a
 //! front edge whose proposed top is shorter than [`COLLAPSE_LENGTH`] against its size
-//! ([`Sizes::collapse_length`]: the target, or a part of its length on the wall where shorter)
+//! ([`EdgeSizes::collapse_length`]: the target, or a part of its length on the wall where shorter)
 //! merges its two columns into one, as the entropy collapse does ([`super::entropy::collapse`]):
 //! a column ends. It is the inverse of the split
 //! ([`super::split`]): where the field coarsens (out of a refinement region) or the front
@@ -18,7 +18,7 @@ use std::f64::consts::FRAC_1_SQRT_2;
 use super::entropy;
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
-use super::split::Sizes;
+use super::split::EdgeSizes;
 
 /// A front edge shorter than this against the collapse sizes is collapsed.
 pub const COLLAPSE_LENGTH: f64 = FRAC_1_SQRT_2;
@@ -40,7 +40,8 @@ pub(super) fn collapse_short_edges(
     let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
     let mut made = 0;
     for _ in 0..MAX_ROUNDS {
-        let mut short = short_edges(plan, front, columns, [h, &height, user]);
+        let sizes = EdgeSizes { target: h, height: &height, user };
+        let mut short = short_edges(plan, front, columns, &sizes);
         short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         let mut touched = vec![false; columns.len()];
         let before = made;
@@ -63,14 +64,9 @@ pub(super) fn collapse_short_edges(
 
 /// The front edges `(length, a, b)` between two moving roots (after the merges so far) that are
 /// shorter than [`COLLAPSE_LENGTH`] against the sizes `[target, layer height, user]`
-/// ([`Sizes::collapse_length`]), each once; fan edges and edges between columns that slide
+/// ([`EdgeSizes::collapse_length`]), each once; fan edges and edges between columns that slide
 /// differently are left out.
-fn short_edges(
-    plan: &SlabPlan,
-    front: &Front,
-    columns: &Columns,
-    sizes: [&[f64]; 3],
-) -> Vec<(f64, u32, u32)> {
+fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, sizes: &EdgeSizes) -> Vec<(f64, u32, u32)> {
     let root = |c: usize| plan.merges.root(c as u32) as usize;
     let mut edges: Vec<(usize, usize)> =
         front.edges().map(|(a, b)| (root(a), root(b))).filter(|&(a, b)| a < b).collect();
@@ -81,7 +77,7 @@ fn short_edges(
         .filter(|&(a, b)| plan.moving[a] && plan.moving[b])
         .filter(|&(a, b)| !columns.is_fan_edge(a, b) && columns.slide[a] == columns.slide[b])
         .filter_map(|(a, b)| {
-            let length = Sizes::collapse_length(columns, sizes, a, b, plan.proposed[b] - plan.proposed[a]);
+            let length = sizes.collapse_length(columns, a, b, plan.proposed[b] - plan.proposed[a]);
             (length < COLLAPSE_LENGTH).then_some((length, a as u32, b as u32))
         })
         .collect()

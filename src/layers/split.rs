@@ -46,7 +46,7 @@ pub const SPLIT_LENGTH: f64 = SQRT_2;
 pub const COMPRESSED: f64 = 0.5;
 
 /// A front edge this many times shorter than its layer is high is collapsed
-/// ([`Sizes::collapse_length`]). At 2, the ONERA M6's wing-tip cap (facets of 0.2-0.4 under a
+/// ([`EdgeSizes::collapse_length`]). At 2, the ONERA M6's wing-tip cap (facets of 0.2-0.4 under a
 /// first layer of 1.67) coarsens: 574 core slivers -> 114, and the first core cells match the
 /// last layer at 99.0% of the front triangles (94.9% before); at 1.4, 58 slivers but the box's
 /// transition layers coarsen too (94.9% -> 93.5%).
@@ -118,41 +118,6 @@ impl<'a> Sizes<'a> {
     /// [`Sizes::tangential`]): the mean of its lengths in the sizes at its ends.
     pub fn edge_length(h: &[f64], a: usize, b: usize, e: DVec3) -> f64 {
         e.length() / mean_size(h, a, b)
-    }
-
-    /// Length of front edge `e` between columns `a` and `b` against the size it is split at:
-    /// the target `h`, or where they are longer the edge's length on the wall and the layer's
-    /// height `height` (a front finer than its layers are high would only make flat cells),
-    /// but the user's size `user` where that is smaller.
-    pub fn split_length(
-        columns: &Columns,
-        [h, height, user]: [&[f64]; 3],
-        a: usize,
-        b: usize,
-        e: DVec3,
-    ) -> f64 {
-        let on_wall = columns.wall_edge_length(a, b).unwrap_or(0.0);
-        let size = mean_size(h, a, b).max(on_wall).max(mean_size(height, a, b));
-        e.length() / size.min(mean_size(user, a, b))
-    }
-
-    /// Length of front edge `e` between columns `a` and `b` against the size it is collapsed
-    /// at: the target `h`, or [`COMPRESSED`] times the edge's length on the wall where that is
-    /// shorter; but an edge [`TALLEST_CELL`] times shorter than the layer's height `height` is
-    /// collapsed anyway (not coarser than the user's size `user`, though): a front finer than
-    /// its layers are high (a wall faceted finer than the first layer, as at a wing tip) makes
-    /// needles, and coarsens whether it compressed or not.
-    pub fn collapse_length(
-        columns: &Columns,
-        [h, height, user]: [&[f64]; 3],
-        a: usize,
-        b: usize,
-        e: DVec3,
-    ) -> f64 {
-        let on_wall = columns.wall_edge_length(a, b).map_or(f64::INFINITY, |w| COMPRESSED * w);
-        // Collapsed below 1/sqrt 2 of this size: once the layer is TALLEST_CELL times its width.
-        let by_height = mean_size(height, a, b) * std::f64::consts::SQRT_2 / TALLEST_CELL;
-        e.length() / mean_size(h, a, b).min(on_wall).max(by_height.min(mean_size(user, a, b)))
     }
 
     /// The length in the sizes of every edge of the raised front (zero-length edges left out),
@@ -259,6 +224,40 @@ impl Splits {
     }
 }
 
+/// The sizes a front edge is split and collapsed against, per column: the target
+/// ([`Sizes::tangential`]), the layer's height and the user's size ([`Sizes::user`]).
+pub struct EdgeSizes<'a> {
+    pub target: &'a [f64],
+    pub height: &'a [f64],
+    pub user: &'a [f64],
+}
+
+impl EdgeSizes<'_> {
+    /// Length of front edge `e` between columns `a` and `b` against the size it is split at:
+    /// the target, or where they are longer the edge's length on the wall and the layer's
+    /// height (a front finer than its layers are high would only make flat cells), but the
+    /// user's size where that is smaller.
+    pub fn split_length(&self, columns: &Columns, a: usize, b: usize, e: DVec3) -> f64 {
+        let on_wall = columns.wall_edge_length(a, b).unwrap_or(0.0);
+        let size = mean_size(self.target, a, b).max(on_wall).max(mean_size(self.height, a, b));
+        e.length() / size.min(mean_size(self.user, a, b))
+    }
+
+    /// Length of front edge `e` between columns `a` and `b` against the size it is collapsed
+    /// at: the target, or [`COMPRESSED`] times the edge's length on the wall where that is
+    /// shorter; but an edge [`TALLEST_CELL`] times shorter than the layer's height is collapsed
+    /// anyway (not coarser than the user's size, though): a front finer than its layers are
+    /// high (a wall faceted finer than the first layer, as at a wing tip) makes needles, and
+    /// coarsens whether it compressed or not.
+    pub fn collapse_length(&self, columns: &Columns, a: usize, b: usize, e: DVec3) -> f64 {
+        let on_wall = columns.wall_edge_length(a, b).map_or(f64::INFINITY, |w| COMPRESSED * w);
+        // Collapsed below 1/sqrt 2 of this size: once the layer is TALLEST_CELL times its width.
+        let by_height = mean_size(self.height, a, b) * std::f64::consts::SQRT_2 / TALLEST_CELL;
+        let size = mean_size(self.target, a, b).min(on_wall).max(by_height.min(mean_size(self.user, a, b)));
+        e.length() / size
+    }
+}
+
 /// The front edges whose proposed top (`proposed[c]` for the live columns) is too long, with
 /// the new column at the middle of each. Only edges between two faces are split (an edge seen
 /// once borders a patch without layers), and only between columns that slide alike.
@@ -278,14 +277,13 @@ pub(super) fn propose(
         .flat_map_iter(|f| {
             let cols = front.face_columns(f);
             let n = cols.len();
-            let (limits, proposed) = ([h, &height[..], &user[..]], proposed);
+            let (limits, proposed) = (EdgeSizes { target: h, height: &height, user: &user }, proposed);
             (0..n).filter_map(move |i| {
                 let (a, b) = (cols[i], cols[(i + 1) % n]);
                 let (ua, ub) = (a as usize, b as usize);
                 let live = columns.alive[ua] && columns.alive[ub];
-                let long = live
-                    && Sizes::split_length(columns, limits, ua, ub, proposed[ub] - proposed[ua])
-                        > SPLIT_LENGTH;
+                let long =
+                    live && limits.split_length(columns, ua, ub, proposed[ub] - proposed[ua]) > SPLIT_LENGTH;
                 long.then_some(([a.min(b), a.max(b)], f as u32, i as u8))
             })
         })
