@@ -172,14 +172,26 @@ impl CrossingGuard {
 
 /// Log every crossing pair with how near the two faces are on the front (columns shared; a
 /// column of one next to or from the same wall vertex as one of the other): far apart, they are
-/// fronts meeting across a gap or a fold, not a local collapse.
+/// fronts meeting across a gap or a fold, not a local collapse; and where they start and how
+/// their columns meet.
 fn trace_crossing_pairs(front: &Front, columns: &Columns, pairs: impl Iterator<Item = (u32, u32)>) {
     for (f, g) in pairs {
         let (a, b) = (front.face_columns(f as usize), front.face_columns(g as usize));
         let shared = a.iter().filter(|c| b.contains(c)).count();
         let wall = |c: u32| columns.wall_vertex[c as usize];
         let near = a.iter().any(|&x| b.iter().any(|&y| front.are_neighbours(x, y) || wall(x) == wall(y)));
-        tracing::trace!(f, g, shared, near, "crossing pair");
+        // Where the two faces start on the wall, how far apart, and how their columns meet
+        // (`converge`: the cosine between their mean directions; `ahead`: of f's direction
+        // with the way from f's wall points to g's, positive when g lies ahead of f).
+        let base = |cs: &[u32]| cs.iter().map(|&c| columns.base[c as usize]).sum::<DVec3>() / cs.len() as f64;
+        let dir = |cs: &[u32]| cs.iter().map(|&c| columns.dir[c as usize]).sum::<DVec3>().normalize_or_zero();
+        let (fb, gb) = (base(a), base(b));
+        let (converge, ahead) = (dir(a).dot(dir(b)), (gb - fb).normalize_or_zero().dot(dir(a)));
+        let layers = a.iter().map(|&c| columns.layers[c as usize]).max().unwrap_or(0);
+        tracing::trace!(
+            f, g, shared, near, at = ?fb.to_array(), apart = fb.distance(gb), converge, ahead, layers,
+            "crossing pair"
+        );
     }
 }
 
