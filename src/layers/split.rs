@@ -485,6 +485,25 @@ mod tests {
     /// On a circle of radius 2 the middle of the arc between two points rises above their
     /// chord's middle by R (1 - cos(phi)); on the inside of the circle (normals converging) it
     /// sinks by as much; between parallel normals it does not move.
+    /// A front edge as long as on the wall (0.3, not compressed) is kept under a thin layer,
+    /// collapsed under one 1.67 high (the ONERA M6's wing tip), but kept where the user asks
+    /// for 0.3 there; it is never split under the tall layer either.
+    #[test]
+    fn an_edge_much_shorter_than_its_layer_is_high_is_collapsed_within_the_users_size() {
+        let columns =
+            Columns { base: vec![DVec3::ZERO, 0.3 * DVec3::X], born_at: vec![0, 0], ..Default::default() };
+        let (e, target, unbounded) = (0.3 * DVec3::X, [0.3; 2], [f64::INFINITY; 2]);
+        let collapse = super::super::coarsen::COLLAPSE_LENGTH;
+        let (thin, tall, user) = ([0.1; 2], [1.67; 2], [0.3; 2]);
+        let thin_layer = EdgeSizes { target: &target, height: &thin, user: &unbounded };
+        let tall_layer = EdgeSizes { target: &target, height: &tall, user: &unbounded };
+        let users_size = EdgeSizes { target: &target, height: &tall, user: &user };
+        assert!(thin_layer.collapse_length(&columns, 0, 1, e) > collapse);
+        assert!(tall_layer.collapse_length(&columns, 0, 1, e) < collapse);
+        assert!(users_size.collapse_length(&columns, 0, 1, e) > collapse);
+        assert!(tall_layer.split_length(&columns, 0, 1, e) < SPLIT_LENGTH);
+    }
+
     #[test]
     fn the_arc_middle_rises_on_convex_walls_and_sinks_on_concave_ones() {
         let (r, phi) = (2.0f64, 0.3f64);
