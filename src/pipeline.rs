@@ -463,6 +463,14 @@ impl std::fmt::Display for MeshReport {
                     "          {} seeds over the front in place (of {} front vertices with a last layer under them)",
                     c.seeds, c.seed_candidates
                 )?;
+                if c.mesher_crashes > 0 {
+                    let then = if c.mesher_crashes == 1 { "over the prisms only" } else { "none" };
+                    writeln!(
+                        f,
+                        "          TetGen crashed on the seeds {} times; meshed with seeds {then}",
+                        c.mesher_crashes
+                    )?;
+                }
                 writeln!(
                     f,
                     "          improvement: {} flips and moves to match the first core cells to the last layer, then {} flips 2-3, {} 3-2, {} 4-4, {} larger edge removals, {} points smoothed, {} inserted ({:.2} s)",

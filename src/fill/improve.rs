@@ -505,10 +505,11 @@ impl TetMesh {
         self.change(tets, add, Some((p, position)))
     }
 
-    /// Insert a point at `p` (then moved where its tetrahedra are best): the tetrahedra whose
-    /// circumsphere holds `p`, grown from the one holding it (found by walking from `start`)
-    /// across interior faces, are replaced by the cone from the new point over their boundary
-    /// (Bowyer-Watson). `None` when `p` is outside the region or the cone is not positive.
+    /// Insert a point at `p` (with [`Placement::Best`], then moved where its tetrahedra are
+    /// best): the tetrahedra whose circumsphere holds `p`, grown from the one holding it (found
+    /// by walking from `start`) across interior faces, are replaced by the cone from the new
+    /// point over their boundary (Bowyer-Watson). `None` when `p` is outside the region or the
+    /// cone is not positive.
     pub fn insert_point(&self, start: u32, p: DVec3, placement: Placement) -> Option<Change> {
         let first = self.locate(start, p)?;
         // The tetrahedron to improve goes too, whether or not its circumsphere holds `p`.

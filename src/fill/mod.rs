@@ -205,8 +205,8 @@ impl CoreGuide {
     }
 
     /// [`CoreGuide::mean_edge_length`] and the seeds over the front's last layer `front` (see
-    /// [`seeds::seed_points`]). A seed and the
-    /// front vertex under it are sized by the larger of the front's edges and the seed's height:
+    /// [`seeds::seed_points`]). A seed and the front vertex under it are sized by the larger of
+    /// the front's edges and the seed's height:
     /// where the last layer is taller than the front is wide, the first core cell is too, and
     /// sized by the edges alone the mesher would split it half way up.
     pub fn with_seeds(boundary: &ClosedBoundary, front: &FrontLayer) -> (CoreGuide, seeds::Seeds) {
@@ -333,6 +333,8 @@ pub struct CoreStats {
     pub steiner_points: usize,
     pub seeds: usize,
     pub seed_candidates: usize,
+    /// Times the mesher crashed on the seeds and was run again with fewer (0 to 2).
+    pub mesher_crashes: usize,
     /// Points the mesher added on the boundary (0: the front is kept exactly).
     pub boundary_steiner_points: usize,
     /// Smallest and largest dihedral angle of the core tetrahedra, degrees.
@@ -415,11 +417,11 @@ pub fn fill_core_with_symmetry(
     let (boundary, nodes) = core.closed_boundary();
     let front_layer = core.front_layer(&nodes, false);
     let mesher_start = Instant::now();
-    let (tets, seeds_used, seeds) = if options.seed_front {
+    let (tets, seeds_used, seeds, mesher_crashes) = if options.seed_front {
         fill_with_seeds(mesher, &boundary, &front_layer, || core.front_layer(&nodes, true))?
     } else {
         let (tets, _) = fill_keeping_boundary(mesher, &boundary, CoreGuide::mean_edge_length(&boundary))?;
-        (tets, 0, seeds::Seeds::default())
+        (tets, 0, seeds::Seeds::default(), 0)
     };
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     // The seeds stay where they are: they give the first core cells the last layer's height.
@@ -431,6 +433,7 @@ pub fn fill_core_with_symmetry(
     stats.quality = quality;
     stats.seeds = seeds_used;
     stats.seed_candidates = seeds.candidates;
+    stats.mesher_crashes = mesher_crashes;
     stats.boundary_steiner_points = tets.boundary_steiner_points;
     stats.mesher_seconds = mesher_seconds;
     stats.seconds = start.elapsed().as_secs_f64();
@@ -440,27 +443,32 @@ pub fn fill_core_with_symmetry(
 /// Run the mesher with the seeds over the front's last layer `front`; when it crashes on them
 /// (TetGen aborts on a failed assertion, seen on the ONERA M6 with seeds over the ramps between
 /// stacks), again with the seeds over the prisms only (`on_prisms`), then with none. Returns
-/// the tetrahedra, the seeds in place and the seeds given.
+/// the tetrahedra, the seeds in place, the seeds given and the crashes.
 fn fill_with_seeds(
     mesher: &dyn CoreMesher,
     boundary: &ClosedBoundary,
     front: &FrontLayer,
     on_prisms: impl FnOnce() -> FrontLayer,
-) -> Result<(CoreTets, usize, seeds::Seeds), FillError> {
-    let (guide, seeds) = CoreGuide::with_seeds(boundary, front);
-    let signal = match fill_keeping_boundary(mesher, boundary, guide) {
-        Err(FillError::TetGenCrashed { signal }) => signal,
-        result => return result.map(|(tets, used)| (tets, used, seeds)),
+) -> Result<(CoreTets, usize, seeds::Seeds, usize), FillError> {
+    let mut next = Some(on_prisms);
+    let mut layer = std::borrow::Cow::Borrowed(front);
+    let mut crashes = 0;
+    let candidates = loop {
+        let (guide, seeds) = CoreGuide::with_seeds(boundary, &layer);
+        let signal = match fill_keeping_boundary(mesher, boundary, guide) {
+            Err(FillError::TetGenCrashed { signal }) => signal,
+            result => return result.map(|(tets, used)| (tets, used, seeds, crashes)),
+        };
+        crashes += 1;
+        let Some(on_prisms) = next.take() else {
+            tracing::warn!(signal, "TetGen crashed: again without seeds");
+            break seeds.candidates;
+        };
+        tracing::warn!(signal, "TetGen crashed: again with the seeds over the prisms only");
+        layer = std::borrow::Cow::Owned(on_prisms());
     };
-    tracing::warn!(signal, "TetGen crashed: again with the seeds over the prisms only");
-    let (guide, seeds) = CoreGuide::with_seeds(boundary, &on_prisms());
-    let signal = match fill_keeping_boundary(mesher, boundary, guide) {
-        Err(FillError::TetGenCrashed { signal }) => signal,
-        result => return result.map(|(tets, used)| (tets, used, seeds)),
-    };
-    tracing::warn!(signal, "TetGen crashed: again without seeds");
     let (tets, _) = fill_keeping_boundary(mesher, boundary, CoreGuide::mean_edge_length(boundary))?;
-    Ok((tets, 0, seeds::Seeds { candidates: seeds.candidates, ..Default::default() }))
+    Ok((tets, 0, seeds::Seeds { candidates, ..Default::default() }, crashes))
 }
 
 /// Times the mesher is run again, with the seeds near the boundary triangle it lost removed,

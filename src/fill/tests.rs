@@ -300,9 +300,9 @@ fn a_mesher_crashing_on_the_seeds_is_run_again_with_fewer_then_none() {
     let front = FrontLayer { heights, steps: vec![DVec3::NAN; boundary.points.len()] };
     assert!(!CoreGuide::with_seeds(&boundary, &front).1.points.is_empty(), "there are seeds to crash on");
     let mesher = CrashesOnSeeds { runs: std::cell::Cell::new(0) };
-    let (tets, used, seeds) =
+    let (tets, used, seeds, crashes) =
         fill_with_seeds(&mesher, &boundary, &front, || front.clone()).expect("no seeds at last");
-    assert_eq!((used, seeds.points.len(), mesher.runs.get()), (0, 0, 3));
+    assert_eq!((used, seeds.points.len(), mesher.runs.get(), crashes), (0, 0, 3, 2));
     assert!(seeds.candidates > 0, "the candidates are still reported");
     merge::check_boundary_kept(&boundary, &tets).expect("a whole fill");
 }
