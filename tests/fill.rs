@@ -322,8 +322,8 @@ fn worst_core_tetrahedra() {
 /// No size jump (issue 5): with `count = "auto"` the layers end isotropic, and the seeds over
 /// the front make the first core tetrahedron on a front triangle about as tall as the last
 /// layer under it. Measured over every front triangle (those on the ramps between stacks
-/// ending a layer apart too): 94.4% within [1/r, r] on this sphere (examples/sphere.stl:
-/// 97.0%); over the prisms only it was 89.9% before the seeds went on along their columns.
+/// ending a layer apart too): 99.9% within [1/r, r] on this sphere (examples/sphere.stl:
+/// 99.2%); over the prisms only it was 89.9% before the seeds leaned along their columns.
 #[test]
 fn auto_layers_on_a_sphere_end_without_a_size_jump() {
     let wall = shapes::icosphere(1.0, 3);
@@ -337,15 +337,15 @@ fn auto_layers_on_a_sphere_end_without_a_size_jump() {
     let jump = &core.size_jump.stats;
     eprintln!("size jump: {jump:?}, seeds {} of {}", core.seeds, core.seed_candidates);
     assert!(core.seeds > core.seed_candidates * 9 / 10, "{} seeds of {}", core.seeds, core.seed_candidates);
-    assert!(jump.within_band >= 0.92, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
+    assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
     assert!((0.9..1.15).contains(&jump.median), "median {}", jump.median);
 }
 
 /// Issue 5's bars with the defaults (h0 = 1e-3 D, 10 layers and transition layers to isotropy)
 /// on the shipped examples: the first core tetrahedron on a front triangle is within [1/r, r]
 /// of the last layer under it (over every front triangle that is a top of the layers, see
-/// `size_jump::LastLayer`) at 95% of them on the sphere (97.0% measured) and 94% on the box
-/// (94.5%: the 95% bar is not met there), and the core has no dihedral angle below 10 degrees.
+/// `size_jump::LastLayer`) at 95% of them on the sphere (99.2% measured) and 94% on the box
+/// (94.9%: the 95% bar is not met there), and the core has no dihedral angle below 10 degrees.
 #[test]
 fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
     for (name, within) in [("sphere.stl", 0.95), ("box.stl", 0.94)] {
@@ -366,11 +366,11 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
     }
 }
 
-/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 94.3% of the front triangles'
-/// first core tetrahedra within [1/r, r] of the last layer (97.7% of those on prisms; the 95%
-/// bar over all is not met). Its core still has 11 tetrahedra below 10 degrees (28 before the
-/// transition stacks stepped down to their stopped neighbours), so the angle bar is not
-/// asserted, only that the steps stay mended.
+/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 95.2% of the front triangles'
+/// first core tetrahedra within [1/r, r] of the last layer (98.3% of those on prisms). Its core
+/// still has 9 tetrahedra below 10 degrees (28 before the transition stacks stepped down to
+/// their stopped neighbours), so the angle bar is not asserted, only that the steps stay
+/// mended.
 #[test]
 fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/fandisk.obj");
@@ -382,7 +382,7 @@ fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     let jump = &core.size_jump.stats;
     eprintln!("fandisk: size jump {jump:?}, {} slivers", core.quality.slivers.count);
     assert!(core.quality.slivers.count <= 15, "{} tetrahedra below 10 deg", core.quality.slivers.count);
-    assert!(jump.within_band >= 0.94, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
+    assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
     let on_prisms = core.size_jump.on_prisms.within_band;
     assert!(on_prisms >= 0.95, "{:.1}% within [1/r, r] on prisms", 100.0 * on_prisms);
 }
