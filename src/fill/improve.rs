@@ -245,6 +245,7 @@ impl TetMesh {
                 let best = flips
                     .chain(removals)
                     .chain(self.raise_apex(key, apex))
+                    .chain(self.insert_matched_apex(t, key, apex))
                     .filter_map(|change| {
                         let gain = self.mismatch_gain(&change);
                         (gain > 0 && change.after >= SLIVER_THRESHOLD.min(change.before))
@@ -261,6 +262,19 @@ impl TetMesh {
             }
         }
         made
+    }
+
+    /// Insert a point at the last layer's height over front triangle `key` (its tetrahedron `t`,
+    /// whose apex `apex` is a fixed point: a front node or a seed), left where it is.
+    fn insert_matched_apex(&self, t: u32, key: [u32; 3], apex: u32) -> Option<Change> {
+        let h = *self.front_height.get(&key)?;
+        if (apex as usize) >= self.fixed {
+            return None;
+        }
+        let [a, b, c] = key.map(|v| self.points[v as usize]);
+        let normal = triangle_area_vector(a, b, c).normalize_or_zero();
+        let side = height_over([a, b, c], self.points[apex as usize]).signum();
+        self.insert_point(t, (a + b + c) / 3.0 + side * h * normal, Placement::AsGiven)
     }
 
     /// Move the added point `apex` of front triangle `key`'s tetrahedron along the triangle's
@@ -514,7 +528,7 @@ impl TetMesh {
         let first = self.locate(start, p)?;
         // The tetrahedron to improve goes too, whether or not its circumsphere holds `p`.
         let mut cavity = vec![first];
-        if start != first && self.in_circumsphere(start, p) {
+        if start != first {
             cavity.push(start);
         }
         let mut i = 0;
@@ -545,8 +559,11 @@ impl TetMesh {
         let new_volume: f64 = add.iter().map(|t| self.volume_at(*t, v, position)).sum();
         let old_volume: f64 =
             cavity.iter().map(|&t| self.volume_at(self.tets[t as usize], v, position)).sum();
-        // A cavity that is not a ball (pinched) would not be filled exactly by the cone.
-        if (new_volume - old_volume).abs() > 1e-9 * old_volume {
+        // A cavity that is not a ball (pinched) would not be filled exactly by the cone, and
+        // one with a point inside would lose it.
+        let kept = |u: &u32| add.iter().any(|t| t.contains(u));
+        let lost = cavity.iter().flat_map(|&t| self.tets[t as usize]).any(|u| !kept(&u));
+        if (new_volume - old_volume).abs() > 1e-9 * old_volume || lost {
             return None;
         }
         self.change(cavity, add, Some((v, position)))
