@@ -267,14 +267,24 @@ impl TetMesh {
     /// Insert a point at the last layer's height over front triangle `key` (its tetrahedron `t`,
     /// whose apex `apex` is a fixed point: a front node or a seed), left where it is.
     fn insert_matched_apex(&self, t: u32, key: [u32; 3], apex: u32) -> Option<Change> {
-        let h = *self.front_height.get(&key)?;
         if (apex as usize) >= self.fixed {
             return None;
         }
-        let [a, b, c] = key.map(|v| self.points[v as usize]);
-        let normal = triangle_area_vector(a, b, c).normalize_or_zero();
-        let side = height_over([a, b, c], self.points[apex as usize]).signum();
-        self.insert_point(t, (a + b + c) / 3.0 + side * h * normal, Placement::AsGiven)
+        self.insert_point(t, self.matched_apex(t, key)?, Placement::AsGiven)
+    }
+
+    /// The point at the last layer's height over the centre of front triangle `face`, on the
+    /// side of its tetrahedron `t`; `None` when it has no last layer.
+    fn matched_apex(&self, t: u32, face: [u32; 3]) -> Option<DVec3> {
+        let h = *self.front_height.get(&sorted_triangle(face))?;
+        let [a, b, c] = face.map(|v| self.points[v as usize]);
+        let apex = self.tets[t as usize].into_iter().find(|v| !face.contains(v))?;
+        let side = match orient3d(a, b, c, self.points[apex as usize]) {
+            Sign::Positive => 1.0,
+            Sign::Negative => -1.0,
+            Sign::Zero => return None,
+        };
+        Some((a + b + c) / 3.0 + side * h * triangle_area_vector(a, b, c).normalize_or_zero())
     }
 
     /// Move the added point `apex` of front triangle `key`'s tetrahedron along the triangle's
@@ -622,10 +632,7 @@ impl TetMesh {
             }
             let [a, b, c] = face.map(|v| self.points[v as usize]);
             points.push((best_apex(a, c, b).0, Placement::Best));
-            if let Some(&h) = self.front_height.get(&sorted_triangle(face)) {
-                let inward = triangle_area_vector(a, c, b).normalize_or_zero();
-                points.push(((a + b + c) / 3.0 + h * inward, Placement::AsGiven));
-            }
+            points.extend(self.matched_apex(t, face).map(|p| (p, Placement::AsGiven)));
         }
         points.extend(circumcentre(self.corners(self.tets[t as usize])).map(|p| (p, Placement::Best)));
         points

@@ -56,14 +56,8 @@ impl LastLayer {
         let mut sums: HashMap<u32, (DVec3, f64)> = HashMap::new();
         for (p, &zone) in prisms.nodes.chunks_exact(6).zip(&prisms.zone) {
             let Ok(nodes) = <[u32; 6]>::try_from(p) else { continue };
-            let Some(x) =
-                nodes.iter().map(|&n| mesh.points.get(n as usize).copied()).collect::<Option<Vec<_>>>()
-            else {
-                continue;
-            };
-            if zone != layer_zone {
-                continue;
-            }
+            let x = nodes.iter().map(|&n| mesh.points.get(n as usize).copied()).collect::<Option<Vec<_>>>();
+            let Some(x) = x.filter(|_| zone == layer_zone) else { continue };
             for i in 0..3 {
                 let sum = sums.entry(nodes[i + 3]).or_insert((DVec3::ZERO, 0.0));
                 sum.0 += x[i + 3] - x[i];
@@ -89,10 +83,8 @@ impl LastLayer {
         if let Some(&h) = self.prism_under.get(&sorted_triangle(nodes)) {
             return (h > 0.0).then_some((h, true));
         }
-        let normal = triangle_area_vector(x[0], x[1], x[2]).normalize_or_zero();
-        let heights: Vec<f64> = self.steps_at(nodes).map(|s| s.dot(normal).abs()).collect();
-        let h = heights.iter().sum::<f64>() / heights.len() as f64;
-        (!heights.is_empty() && h > 0.0 && !self.is_side_face(nodes, x)).then_some((h, false))
+        let (h, cosine) = self.ramp(nodes, x)?;
+        (h > 0.0 && cosine >= SIDE_COSINE).then_some((h, false))
     }
 
     /// Whether front triangle `nodes` (at `x`, with no prism under it) is a side of the layers
@@ -100,14 +92,17 @@ impl LastLayer {
     /// mean within [`SIDE_COSINE`] of its plane), as on the cliff where a stack ends beside a
     /// taller one. A layer height across it means nothing.
     pub fn is_side_face(&self, nodes: [u32; 3], x: [DVec3; 3]) -> bool {
-        let normal = triangle_area_vector(x[0], x[1], x[2]).normalize_or_zero();
-        let cosines: Vec<f64> =
-            self.steps_at(nodes).map(|s| s.normalize_or_zero().dot(normal).abs()).collect();
-        !cosines.is_empty() && cosines.iter().sum::<f64>() / (cosines.len() as f64) < SIDE_COSINE
+        self.ramp(nodes, x).is_some_and(|(_, cosine)| cosine < SIDE_COSINE)
     }
 
-    fn steps_at(&self, nodes: [u32; 3]) -> impl Iterator<Item = DVec3> + '_ {
-        nodes.into_iter().filter_map(|n| self.steps.get(&n).copied())
+    /// Over the last steps at the nodes of front triangle `nodes` (at `x`): the mean of their
+    /// lengths along its normal and of their cosines with it; `None` when no node has one.
+    fn ramp(&self, nodes: [u32; 3], x: [DVec3; 3]) -> Option<(f64, f64)> {
+        let normal = triangle_area_vector(x[0], x[1], x[2]).normalize_or_zero();
+        let steps: Vec<DVec3> = nodes.into_iter().filter_map(|n| self.steps.get(&n).copied()).collect();
+        let mean = |f: &dyn Fn(DVec3) -> f64| steps.iter().map(|&s| f(s)).sum::<f64>() / steps.len() as f64;
+        (!steps.is_empty())
+            .then(|| (mean(&|s| s.dot(normal).abs()), mean(&|s| s.normalize_or_zero().dot(normal).abs())))
     }
 }
 

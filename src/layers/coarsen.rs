@@ -38,9 +38,9 @@ pub(super) fn collapse_short_edges(
     cells_valid: impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> usize {
     let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
+    let sizes = EdgeSizes { target: h, height: &height, user };
     let mut made = 0;
     for _ in 0..MAX_ROUNDS {
-        let sizes = EdgeSizes { target: h, height: &height, user };
         let mut short = short_edges(plan, front, columns, &sizes);
         short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         let mut touched = vec![false; columns.len()];

@@ -482,9 +482,6 @@ pub(super) fn commit(
 mod tests {
     use super::*;
 
-    /// On a circle of radius 2 the middle of the arc between two points rises above their
-    /// chord's middle by R (1 - cos(phi)); on the inside of the circle (normals converging) it
-    /// sinks by as much; between parallel normals it does not move.
     /// A front edge as long as on the wall (0.3, not compressed) is kept under a thin layer,
     /// collapsed under one 1.67 high (the ONERA M6's wing tip), but kept where the user asks
     /// for 0.3 there; it is never split under the tall layer either.
@@ -504,6 +501,9 @@ mod tests {
         assert!(tall_layer.split_length(&columns, 0, 1, e) < SPLIT_LENGTH);
     }
 
+    /// On a circle of radius 2 the middle of the arc between two points rises above their
+    /// chord's middle by R (1 - cos(phi)); on the inside of the circle (normals converging) it
+    /// sinks by as much; between parallel normals it does not move.
     #[test]
     fn the_arc_middle_rises_on_convex_walls_and_sinks_on_concave_ones() {
         let (r, phi) = (2.0f64, 0.3f64);
