@@ -19,9 +19,11 @@
 //! edge.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
+use crate::sizing::wall::WallDistance;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
 
@@ -88,18 +90,28 @@ pub(super) fn collapse_crushed_edge(
     Some(plan.merges.group(root).collect())
 }
 
-/// The normals of the wall triangles at every wall vertex (through the surface's topology).
+/// What the entropy collapse knows of the wall: the normals of the wall triangles at every wall
+/// vertex (through the surface's topology), and the distance to the walls that get layers.
 pub struct VertexWalls<'a> {
     topology: &'a Topology,
     /// Every wall triangle's unit normal.
     normals: Vec<DVec3>,
+    /// The triangles of the patches with layers (the others are no front to be overtaken by).
+    layered: WallDistance,
 }
 
 impl<'a> VertexWalls<'a> {
-    pub fn new(surface: &Surface, topology: &'a Topology) -> Self {
+    /// `layered(p)`: whether patch `p` gets layers.
+    pub fn new(surface: &Surface, topology: &'a Topology, layered: impl Fn(u32) -> bool) -> Self {
+        let mut walls = surface.clone();
+        let keep: Vec<usize> =
+            (0..surface.triangles.len()).filter(|&t| layered(surface.triangle_patch[t])).collect();
+        walls.triangles = keep.iter().map(|&t| surface.triangles[t]).collect();
+        walls.triangle_patch = keep.iter().map(|&t| surface.triangle_patch[t]).collect();
         VertexWalls {
             topology,
             normals: (0..surface.triangles.len()).map(|t| surface.triangle_normal(t)).collect(),
+            layered: WallDistance::new(&walls),
         }
     }
 
@@ -108,6 +120,11 @@ impl<'a> VertexWalls<'a> {
         let triangles =
             if (v as usize) < self.topology.vertex_count() { self.topology.vertex_triangles(v) } else { &[] };
         triangles.iter().map(|&t| self.normals[t as usize])
+    }
+
+    /// Distance from `p` to the nearest wall with layers (infinite when there is none).
+    pub fn distance(&self, p: DVec3) -> f64 {
+        self.layered.closest(p).map_or(f64::INFINITY, |w| w.distance)
     }
 }
 
@@ -135,6 +152,8 @@ pub(super) fn merge_bisector_crossings(
             }
             // The nearest bisector it has passed (one ridge column beside another may see the
             // same crossing: the nearer keeps the front's cells in shape).
+            // The nearest bisector it has passed (one ridge column beside another may see the
+            // same crossing: the nearer keeps the front's cells in shape).
             let top = |x: u32| plan.proposed[x as usize];
             let Some(r) = passed_bisectors(plan, front, columns, points, walls, c, ANTICIPATION)
                 .into_iter()
@@ -157,6 +176,109 @@ pub(super) fn merge_bisector_crossings(
     }
 }
 
+/// A column has been overtaken by another wall's front once its proposed top lags its layer's
+/// distance from the wall by more than this many of its layer's heights, counting
+/// [`ANTICIPATION`] times what it fell behind in this layer.
+const OVERTAKEN: f64 = 0.1;
+
+/// A column falling behind by less than this many layer heights in one layer is not being
+/// overtaken: a split column (a chord across a convex front) lags the offset by as much at its
+/// bottom as at its top, and so do faceting errors. (The lag of a column passing a 90-degree
+/// ridge's bisector grows by about one height per layer; with no floor on it every column
+/// counts as late: fandisk's coverage near concave ridges fell to 50%.)
+const FALLING_BEHIND: f64 = 0.25;
+
+/// How late root `c`'s proposed top (its `k`-th layer) is on the first-arrival offset: its lag
+/// behind the layer's distance from the wall, in layer heights, plus [`ANTICIPATION`] times
+/// what it fell behind since its bottom; 0 for a column not falling behind
+/// ([`FALLING_BEHIND`]) or past its stack.
+fn lateness(
+    plan: &SlabPlan,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    c: u32,
+    k: u32,
+) -> f64 {
+    let (Some(d), Some(d_below)) = (columns.distance(c as usize, k), columns.distance(c as usize, k - 1))
+    else {
+        return 0.0;
+    };
+    let h = d - d_below;
+    let top = (d - walls.distance(plan.proposed[c as usize])) / h;
+    let bottom = (d_below - walls.distance(points[columns.node[c as usize] as usize])) / h;
+    if h > 0.0 && top - bottom > FALLING_BEHIND {
+        top + ANTICIPATION * (top - bottom)
+    } else {
+        0.0
+    }
+}
+
+/// Merge every column that another wall's front has overtaken ([`OVERTAKEN`]) into a neighbour
+/// root that is on time (the least late that the cells allow), which keeps its top: the
+/// first-arrival rule itself, wherever fronts meet, with or without a feature ridge between
+/// them (a step narrower than the layers are thick, a fin's edge at a body, a concave valley).
+/// The latest go first. A column whose neighbours are all late (fronts meeting head on across
+/// a gap) is left to the crossing guard, which ends the stacks at the medial surface.
+pub(super) fn merge_overtaken(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    k: u32,
+    invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
+) {
+    let is_root = |plan: &SlabPlan, c: u32| plan.moving[c as usize] && !plan.merges.is_merged(c);
+    let late = |plan: &SlabPlan, c: u32| lateness(plan, columns, points, walls, c, k);
+    loop {
+        let mut overtaken: Vec<(f64, u32)> = (0..columns.len() as u32)
+            .into_par_iter()
+            .filter(|&c| is_root(plan, c))
+            .map(|c| (late(plan, c), c))
+            .filter(|&(l, _)| l > OVERTAKEN)
+            .collect();
+        overtaken.sort_by(|x, y| y.0.total_cmp(&x.0));
+        let mut merged = false;
+        for (_, c) in overtaken {
+            if !is_root(plan, c) {
+                continue;
+            }
+            // Equally late, the nearest top: merging moves the front least.
+            let apart = |r: u32| plan.proposed[r as usize].distance_squared(plan.proposed[c as usize]);
+            let mut on_time: Vec<(f64, f64, u32)> = neighbour_roots(plan, front, c)
+                .into_iter()
+                .filter(|&r| is_root(plan, r) && can_merge(plan, front, columns, r, c))
+                .map(|r| (late(plan, r), apart(r), r))
+                .filter(|&(l, _, _)| l <= OVERTAKEN)
+                .collect();
+            on_time.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+            merged |= on_time.into_iter().any(|(_, _, r)| {
+                let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
+                let before = invalid_cells(plan, &group);
+                try_merge_as(plan, columns, (r, c, false), &|plan, group| {
+                    invalid_cells(plan, group) <= before
+                })
+            });
+        }
+        if !merged {
+            break;
+        }
+    }
+}
+
+/// The roots of the columns next to root `c`'s group on the front, other than `c`.
+fn neighbour_roots(plan: &SlabPlan, front: &Front, c: u32) -> Vec<u32> {
+    let mut next = Vec::new();
+    for g in plan.merges.group(c) {
+        front.neighbours(g as usize, &mut next);
+    }
+    let mut roots: Vec<u32> = next.iter().map(|&x| plan.merges.root(x as u32)).filter(|&r| r != c).collect();
+    roots.sort_unstable();
+    roots.dedup();
+    roots
+}
+
 /// The concave ridge columns (roots) beside root `c`'s group whose bisectors `c` has passed, or
 /// will within `anticipation` of its last approach ([`crosses_bisector`]).
 fn passed_bisectors(
@@ -168,20 +290,11 @@ fn passed_bisectors(
     c: u32,
     anticipation: f64,
 ) -> Vec<u32> {
-    let mut next = Vec::new();
-    for g in plan.merges.group(c) {
-        front.neighbours(g as usize, &mut next);
-    }
-    let mut passed: Vec<u32> = next
-        .iter()
-        .map(|&x| plan.merges.root(x as u32))
-        .filter(|&r| {
-            columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
-                && crosses_bisector(plan, columns, points, walls, r, c, anticipation)
-        })
-        .collect();
-    passed.sort_unstable();
-    passed.dedup();
+    let mut passed = neighbour_roots(plan, front, c);
+    passed.retain(|&r| {
+        columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
+            && crosses_bisector(plan, columns, points, walls, r, c, anticipation)
+    });
     passed
 }
 
@@ -453,22 +566,30 @@ fn survivor(columns: &Columns, a: u32, b: u32) -> (u32, u32, bool) {
 
 /// Merge roots `a` and `b` (see [`survivor`]).
 pub(super) fn collapse(plan: &mut SlabPlan, columns: &Columns, a: u32, b: u32) {
-    let (sa, sb) = (columns.scale[a as usize], columns.scale[b as usize]);
+    merge_as(plan, columns, survivor(columns, a, b));
+}
+
+/// Merge root `drop` into root `keep`, `keep`'s top moving to the middle of theirs if `middle`.
+fn merge_as(plan: &mut SlabPlan, columns: &Columns, (keep, drop, middle): (u32, u32, bool)) {
+    let (sk, sd) = (columns.scale[keep as usize], columns.scale[drop as usize]);
     let at = |c: u32| columns.base[c as usize].as_vec3();
-    tracing::debug!("collapse columns {a} at {} (scale {sa:.3}) and {b} at {} (scale {sb:.3})", at(a), at(b));
-    let (keep, drop, middle) = survivor(columns, a, b);
+    tracing::debug!(
+        "collapse columns {keep} at {} (scale {sk:.3}) and {drop} at {} (scale {sd:.3})",
+        at(keep),
+        at(drop)
+    );
     if middle {
         let (k, d) = (keep as usize, drop as usize);
         plan.proposed[k] = columns.slide[k].project(0.5 * (plan.proposed[k] + plan.proposed[d]));
         let dir = (columns.dir[k] + columns.dir[d]).normalize_or(columns.dir[k]);
-        plan.redirected.push((keep, dir, 0.5 * (sa + sb)));
+        plan.redirected.push((keep, dir, 0.5 * (sk + sd)));
     }
     plan.merges.merge(keep, drop);
     plan.collapses += 1;
 }
 
-/// Merge roots `a` and `b`; undo the merge (and keep the plan as it was) if a cell around them
-/// turns invalid.
+/// Merge roots `a` and `b` (see [`survivor`]); undo the merge (and keep the plan as it was) if a
+/// cell around them turns invalid.
 pub(super) fn try_collapse(
     plan: &mut SlabPlan,
     columns: &Columns,
@@ -476,11 +597,21 @@ pub(super) fn try_collapse(
     b: u32,
     cells_valid: &impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> bool {
+    try_merge_as(plan, columns, survivor(columns, a, b), cells_valid)
+}
+
+/// [`merge_as`], undone unless `cells_valid` holds for the merged group.
+fn try_merge_as(
+    plan: &mut SlabPlan,
+    columns: &Columns,
+    how: (u32, u32, bool),
+    cells_valid: &impl Fn(&SlabPlan, &[u32]) -> bool,
+) -> bool {
+    let (a, b, _) = how;
     let saved = (plan.proposed[a as usize], plan.proposed[b as usize], plan.redirected.len());
     let merges_before = plan.merges.clone_groups(a, b);
-    collapse(plan, columns, a, b);
-    let keep = plan.merges.root(a);
-    let group: Vec<u32> = plan.merges.group(keep).collect();
+    merge_as(plan, columns, how);
+    let group: Vec<u32> = plan.merges.group(a).collect();
     if cells_valid(plan, &group) {
         return true;
     }
@@ -539,7 +670,7 @@ mod tests {
         };
         assert_eq!((surface.triangle_normal(0), surface.triangle_normal(1)), (DVec3::Y, DVec3::X));
         let topology = Topology::new(&surface);
-        let walls = VertexWalls::new(&surface, &topology);
+        let walls = VertexWalls::new(&surface, &topology, |_| true);
         crosses_bisector(&plan, &columns, &[DVec3::ZERO, at], &walls, 0, 1, anticipation)
     }
 
@@ -556,6 +687,63 @@ mod tests {
         // To mend a cell, a column two approaches short of the bisector merges, not three.
         assert!(ridge_case_ahead(at, DVec3::Y, 0.04, REPAIR_ANTICIPATION));
         assert!(!ridge_case_ahead(at, DVec3::Y, 0.02, REPAIR_ANTICIPATION));
+    }
+
+    /// Lateness (in layer heights) of a column from `bottom` to `top` at its layer `k` of
+    /// uniform 0.1-high layers, over the 90-degree ridge's walls of [`ridge_case`] (extended
+    /// far out).
+    fn lateness_case(bottom: DVec3, top: DVec3, k: u32) -> f64 {
+        let settings = crate::config::LayerSettings {
+            first_height: Some(0.1),
+            growth: Some(1.0),
+            count: Some(crate::config::LayerCount::Fixed(20)),
+            thickness: None,
+            transition: Some(false),
+        };
+        let spec = crate::config::LayerSpec::resolve(&settings, 1.0).unwrap();
+        let mut columns = Columns::default();
+        columns.push(ColumnStart {
+            base: bottom,
+            dir: (top - bottom).normalize(),
+            scale: 1.0,
+            node: 0,
+            layers: k - 1,
+            wall_vertex: 0,
+            slide: Default::default(),
+            spec: Some(spec),
+            last_step: 0.1,
+        });
+        let plan = SlabPlan {
+            moving: vec![true],
+            proposed: vec![top],
+            merges: super::super::collapse::Merges::new(1),
+            redirected: Vec::new(),
+            collapses: 0,
+            coarsened: 0,
+        };
+        let far = 10.0;
+        let surface = Surface {
+            points: vec![DVec3::ZERO, far * DVec3::Z, far * DVec3::X, far * DVec3::Y],
+            triangles: vec![[0, 1, 2], [0, 3, 1]],
+            triangle_patch: vec![0, 0],
+            patch_names: vec!["wall".into()],
+        };
+        let topology = Topology::new(&surface);
+        let walls = VertexWalls::new(&surface, &topology, |_| true);
+        lateness(&plan, &columns, &[bottom], &walls, 0, k)
+    }
+
+    #[test]
+    fn a_column_passing_the_other_walls_offset_is_late_and_a_chord_is_not() {
+        // On wall 1 (y = 0) 0.25 from wall 2 (x = 0), moving up +y: layer 2 (0.1 to 0.2) is on
+        // time, layer 3 (0.2 to 0.3) ends 0.05 nearer wall 2 than its distance, and fell behind
+        // by as much: half a layer late, plus half anticipated.
+        let at = |d: f64| DVec3::new(0.25, d, 1.0);
+        assert_eq!(lateness_case(at(0.1), at(0.2), 2), 0.0);
+        assert!((lateness_case(at(0.2), at(0.3), 3) - 1.0).abs() < 1e-9);
+        // Late by as much at its bottom as at its top (a split column's chord): not overtaken.
+        let chord = |d: f64| DVec3::new(2.0, d - 0.05, 1.0);
+        assert_eq!(lateness_case(chord(0.2), chord(0.3), 3), 0.0);
     }
 
     /// A corner overtaking its opposite edge while no edge of the triangle shrinks much.

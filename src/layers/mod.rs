@@ -82,7 +82,7 @@ pub fn build_layers(
         ..Default::default()
     };
     let mut sizes = split::Sizes::new(adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
-    let walls = entropy::VertexWalls::new(surface, topology);
+    let walls = entropy::VertexWalls::new(surface, topology, layered);
     let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, &walls, |k| {
         on_layer(k, max_layers)
     });
