@@ -152,8 +152,6 @@ pub(super) fn merge_bisector_crossings(
             }
             // The nearest bisector it has passed (one ridge column beside another may see the
             // same crossing: the nearer keeps the front's cells in shape).
-            // The nearest bisector it has passed (one ridge column beside another may see the
-            // same crossing: the nearer keeps the front's cells in shape).
             let top = |x: u32| plan.proposed[x as usize];
             let Some(r) = passed_bisectors(plan, front, columns, points, walls, c, ANTICIPATION)
                 .into_iter()
@@ -547,6 +545,42 @@ fn collapse_most_shrunk_edge(
         .map(|(a, b)| (edge_ratio(plan, columns, points, a, b), a, b))
         .filter(|&(ratio, _, _)| ratio < MEETING_RATIO)
         .min_by(|x, y| x.0.total_cmp(&y.0))?;
+    collapse(plan, columns, a, b);
+    Some(plan.merges.root(a))
+}
+
+/// Mend invalid face `f` by a merge along one of its edges that leaves every cell around the
+/// merged column valid; returns the surviving root. The last repair before stopping columns:
+/// at a saddle corner (a fin's trailing edge at the body, a step's end at a side wall) a
+/// corner's fan and the bisector column beside it converge with no edge crushed, no bisector
+/// passed and neither column late, and their cell turns inside out. Only where one column
+/// absorbs the other (the larger scale survives, see [`survivor`]: two of a kind would meet in
+/// the middle, off the offset; two ridge columns along a fin junction folded the arrow's
+/// front), and only between wall points that the two columns' travel spans (fronts collapsing
+/// in a closed box bring columns from far apart next to each other: merging those folded the
+/// front onto itself).
+pub(super) fn merge_to_mend(
+    plan: &mut SlabPlan,
+    front: &Front,
+    f: usize,
+    columns: &Columns,
+    invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
+) -> Option<u32> {
+    let face = plan.merges.resolved_face(front, f)?;
+    let n = face.nodes();
+    let base = |c: u32| columns.base[c as usize];
+    let travel = |c: u32| plan.proposed[c as usize].distance(base(c));
+    let near = |a: u32, b: u32| base(a).distance(base(b)) <= travel(a) + travel(b);
+    let (a, b) = (0..n.len()).map(|i| (n[i], n[(i + 1) % n.len()])).find(|&(a, b)| {
+        if !can_merge(plan, front, columns, a, b) || survivor(columns, a, b).2 || !near(a, b) {
+            return false;
+        }
+        let mut trial = plan.clone();
+        collapse(&mut trial, columns, a, b);
+        let merged: Vec<u32> = trial.merges.group(trial.merges.root(a)).collect();
+        invalid_cells(&trial, &merged) == 0
+    })?;
+    tracing::debug!(f, a, b, at = ?columns.base[a as usize], "invalid cell mended by a merge");
     collapse(plan, columns, a, b);
     Some(plan.merges.root(a))
 }

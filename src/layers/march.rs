@@ -710,6 +710,13 @@ fn repair_invalid_cells(
         }
         if changed.is_empty() && changed_faces.is_empty() {
             for &f in &uncollapsed {
+                let invalid_cells = |plan: &SlabPlan, group: &[u32]| {
+                    invalid_cells_around(plan, reshape, mesh, columns, front, group)
+                };
+                if let Some(root) = entropy::merge_to_mend(plan, front, f, columns, &invalid_cells) {
+                    changed.extend(plan.merges.group(root));
+                    continue;
+                }
                 tracing::debug!(face = f, at = ?wall_points(front, f, columns), "invalid cell: stopping its columns");
                 if tracing::enabled!(tracing::Level::TRACE) {
                     trace_invalid_cell(plan, reshape, mesh, columns, front, f);
