@@ -17,6 +17,12 @@
 //! much: a corner closes in on its opposite edge (the bisector column passing the face columns
 //! in front of it). Such a face loses that corner instead, merged into the nearer end of the
 //! edge.
+//!
+//! Fronts also meet with no ridge between them (a step lower than the layers are thick, a fin's
+//! edge at a body, a concave valley): a column whose top falls behind its layer's distance from
+//! the wall (a BVH over the walls with layers) merges into a neighbour on time
+//! ([`merge_overtaken`]). Last, before a cell's columns stop, a merge along one of its edges
+//! that leaves every cell around valid mends it ([`merge_to_mend`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -662,6 +668,29 @@ mod tests {
     use super::*;
     use crate::layers::front::ColumnStart;
 
+    /// A slab plan moving every column to its `proposed` top, nothing merged yet.
+    fn plan_of(proposed: Vec<DVec3>) -> SlabPlan {
+        SlabPlan {
+            moving: vec![true; proposed.len()],
+            merges: super::super::collapse::Merges::new(proposed.len()),
+            proposed,
+            redirected: Vec::new(),
+            collapses: 0,
+            coarsened: 0,
+        }
+    }
+
+    /// The ridge vertex 0 at the origin with one triangle `size` long on each wall: wall 1
+    /// (y = 0, x > 0, normal +y) and wall 2 (x = 0, y > 0, normal +x).
+    fn two_walls(size: f64) -> Surface {
+        Surface {
+            points: vec![DVec3::ZERO, size * DVec3::Z, size * DVec3::X, size * DVec3::Y],
+            triangles: vec![[0, 1, 2], [0, 3, 1]],
+            triangle_patch: vec![0, 0],
+            patch_names: vec!["wall".into()],
+        }
+    }
+
     /// A 90-degree concave ridge along z at the origin between wall 1 (y = 0, x > 0, normal +y)
     /// and wall 2 (x = 0, y > 0, normal +x): column 0 on the ridge, column 1 at `at` on the
     /// wall with direction `dir`, both `d` out (the ridge column by its scale, on the bisector).
@@ -687,21 +716,8 @@ mod tests {
                 last_step: 0.0,
             });
         }
-        let plan = SlabPlan {
-            moving: vec![true; 2],
-            proposed: vec![bisector * 2f64.sqrt() * d, at + dir * d],
-            merges: super::super::collapse::Merges::new(2),
-            redirected: Vec::new(),
-            collapses: 0,
-            coarsened: 0,
-        };
-        // The ridge vertex 0 with one triangle on each wall.
-        let surface = Surface {
-            points: vec![DVec3::ZERO, DVec3::Z, DVec3::X, DVec3::Y],
-            triangles: vec![[0, 1, 2], [0, 3, 1]],
-            triangle_patch: vec![0, 0],
-            patch_names: vec!["wall".into()],
-        };
+        let plan = plan_of(vec![bisector * 2f64.sqrt() * d, at + dir * d]);
+        let surface = two_walls(1.0);
         assert_eq!((surface.triangle_normal(0), surface.triangle_normal(1)), (DVec3::Y, DVec3::X));
         let topology = Topology::new(&surface);
         let walls = VertexWalls::new(&surface, &topology, |_| true);
@@ -724,8 +740,7 @@ mod tests {
     }
 
     /// Lateness (in layer heights) of a column from `bottom` to `top` at its layer `k` of
-    /// uniform 0.1-high layers, over the 90-degree ridge's walls of [`ridge_case`] (extended
-    /// far out).
+    /// uniform 0.1-high layers, over [`two_walls`] extended far out.
     fn lateness_case(bottom: DVec3, top: DVec3, k: u32) -> f64 {
         let settings = crate::config::LayerSettings {
             first_height: Some(0.1),
@@ -747,21 +762,8 @@ mod tests {
             spec: Some(spec),
             last_step: 0.1,
         });
-        let plan = SlabPlan {
-            moving: vec![true],
-            proposed: vec![top],
-            merges: super::super::collapse::Merges::new(1),
-            redirected: Vec::new(),
-            collapses: 0,
-            coarsened: 0,
-        };
-        let far = 10.0;
-        let surface = Surface {
-            points: vec![DVec3::ZERO, far * DVec3::Z, far * DVec3::X, far * DVec3::Y],
-            triangles: vec![[0, 1, 2], [0, 3, 1]],
-            triangle_patch: vec![0, 0],
-            patch_names: vec!["wall".into()],
-        };
+        let plan = plan_of(vec![top]);
+        let surface = two_walls(10.0);
         let topology = Topology::new(&surface);
         let walls = VertexWalls::new(&surface, &topology, |_| true);
         lateness(&plan, &columns, &[bottom], &walls, 0, k)
