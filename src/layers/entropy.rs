@@ -66,9 +66,21 @@ fn moving_roots(plan: &SlabPlan, a: u32, b: u32) -> bool {
 /// 1 for parallel columns, less where they converge, negative once the top has turned over.
 /// `None` for a face that is degenerate at the bottom (fan faces at the wall).
 fn area_ratio(plan: &SlabPlan, front: &Front, f: usize, columns: &Columns, points: &[DVec3]) -> Option<f64> {
+    area_ratio_with(plan, front, f, columns, points, |c| plan.merges.root(c))
+}
+
+/// [`area_ratio`] with the tops of the columns' roots as `root` says.
+fn area_ratio_with(
+    plan: &SlabPlan,
+    front: &Front,
+    f: usize,
+    columns: &Columns,
+    points: &[DVec3],
+    root: impl Fn(u32) -> u32,
+) -> Option<f64> {
     let cols = front.face_columns(f);
     let bottom: Vec<DVec3> = cols.iter().map(|&c| points[columns.node[c as usize] as usize]).collect();
-    let top: Vec<DVec3> = cols.iter().map(|&c| plan.proposed[plan.merges.root(c) as usize]).collect();
+    let top: Vec<DVec3> = cols.iter().map(|&c| plan.proposed[root(c) as usize]).collect();
     let (nb, nt) = (newell(&bottom), newell(&top));
     let area = nb.length();
     (area > 0.0).then(|| nt.dot(nb) / (area * area))
@@ -159,9 +171,16 @@ pub(super) fn merge_bisector_crossings(
             // The nearest bisector it has passed (one ridge column beside another may see the
             // same crossing: the nearer keeps the front's cells in shape).
             let top = |x: u32| plan.proposed[x as usize];
+            // Equally near (a face column half way between two ridge columns), the one that
+            // leaves no face flat ([`flattened_if_merged`]).
+            let key = |x: u32| {
+                (flattened_if_merged(plan, front, columns, points, x, c), top(x).distance_squared(top(c)))
+            };
             let Some(r) = passed_bisectors(plan, front, columns, points, walls, c, ANTICIPATION)
                 .into_iter()
-                .min_by(|&x, &y| top(x).distance_squared(top(c)).total_cmp(&top(y).distance_squared(top(c))))
+                .map(|x| (key(x), x))
+                .min_by(|(kx, _), (ky, _)| kx.0.cmp(&ky.0).then(kx.1.total_cmp(&ky.1)))
+                .map(|(_, x)| x)
             else {
                 continue;
             };
@@ -281,6 +300,36 @@ fn neighbour_roots(plan: &SlabPlan, front: &Front, c: u32) -> Vec<u32> {
     roots.sort_unstable();
     roots.dedup();
     roots
+}
+
+/// A face top keeping less than this fraction of its bottom's area, with three corners or more
+/// still apart, is flat.
+const FLAT_TOP: f64 = 0.05;
+
+/// How many faces around root `c`'s group would be left flat ([`FLAT_TOP`]) with three distinct
+/// corners if `c` merged into root `r`: two face columns beside a ridge merged into two ridge
+/// columns with a third between them fold the front along the ridge, every cell valid.
+fn flattened_if_merged(
+    plan: &SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    r: u32,
+    c: u32,
+) -> usize {
+    let group: Vec<u32> = plan.merges.group(c).collect();
+    let root = |x: u32| if plan.merges.root(x) == c { r } else { plan.merges.root(x) };
+    front
+        .faces_around_columns(&group)
+        .into_iter()
+        .filter(|&f| {
+            let mut roots: Vec<u32> = front.face_columns(f).iter().map(|&x| root(x)).collect();
+            roots.sort_unstable();
+            roots.dedup();
+            roots.len() >= 3
+                && area_ratio_with(plan, front, f, columns, points, root).is_some_and(|a| a < FLAT_TOP)
+        })
+        .count()
 }
 
 /// The concave ridge columns (roots) beside root `c`'s group whose bisectors `c` has passed, or
@@ -780,6 +829,41 @@ mod tests {
         // Late by as much at its bottom as at its top (a split column's chord): not overtaken.
         let chord = |d: f64| DVec3::new(2.0, d - 0.05, 1.0);
         assert_eq!(lateness_case(chord(0.2), chord(0.3), 3), 0.0);
+    }
+
+    /// Ridge columns 0, 1, 2 along x at y = 0 and face columns 3 (x = 0.5) and 4 (x = 1.5) at
+    /// y = 1, in triangles (0, 1, 3), (3, 1, 4), (1, 2, 4); every top 0.1 up the ridge's
+    /// bisector, so the ridge columns' tops lie on a line. Column 3 has merged into 0.
+    #[test]
+    fn a_merge_that_would_fold_the_front_along_a_ridge_is_seen() {
+        let bottoms =
+            [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (0.5, 1.0), (1.5, 1.0)].map(|(x, y)| DVec3::new(x, y, 0.0));
+        let mut columns = Columns::default();
+        for (c, &base) in bottoms.iter().enumerate() {
+            columns.push(ColumnStart {
+                base,
+                dir: DVec3::Z,
+                scale: 1.0,
+                node: c as u32,
+                layers: 0,
+                wall_vertex: c as u32,
+                slide: Default::default(),
+                spec: None,
+                last_step: 0.0,
+            });
+        }
+        let mut front = Front::default();
+        for t in [[0, 1, 3], [3, 1, 4], [1, 2, 4]] {
+            front.push(&t, 0, None);
+        }
+        front.index_columns(5);
+        let up = DVec3::new(0.0, 0.1, 0.1);
+        let mut plan = plan_of(bottoms.iter().map(|&b| DVec3::new(b.x, 0.0, 0.0) + up).collect());
+        plan.merges.merge(0, 3);
+        // Into 2: triangle (3, 1, 4) becomes (0, 1, 2), three tops on a line.
+        assert_eq!(flattened_if_merged(&plan, &front, &columns, &bottoms, 2, 4), 1);
+        // Into 1: it keeps two corners and vanishes, and so does (1, 2, 4): nothing left flat.
+        assert_eq!(flattened_if_merged(&plan, &front, &columns, &bottoms, 1, 4), 0);
     }
 
     /// A corner overtaking its opposite edge while no edge of the triangle shrinks much.
