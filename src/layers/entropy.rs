@@ -253,13 +253,15 @@ pub(super) fn merge_overtaken(
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) {
     let is_root = |plan: &SlabPlan, c: u32| plan.moving[c as usize] && !plan.merges.is_merged(c);
-    let late = |plan: &SlabPlan, c: u32| lateness(plan, columns, points, walls, c, k);
+    // The merges here keep the survivors' tops, so every column's lateness holds all along.
+    let late: Vec<f64> = (0..columns.len() as u32)
+        .into_par_iter()
+        .map(|c| if plan.moving[c as usize] { lateness(plan, columns, points, walls, c, k) } else { 0.0 })
+        .collect();
     loop {
         let mut overtaken: Vec<(f64, u32)> = (0..columns.len() as u32)
-            .into_par_iter()
-            .filter(|&c| is_root(plan, c))
-            .map(|c| (late(plan, c), c))
-            .filter(|&(l, _)| l > OVERTAKEN)
+            .filter(|&c| is_root(plan, c) && late[c as usize] > OVERTAKEN)
+            .map(|c| (late[c as usize], c))
             .collect();
         overtaken.sort_by(|x, y| y.0.total_cmp(&x.0));
         let mut merged = false;
@@ -272,7 +274,7 @@ pub(super) fn merge_overtaken(
             let mut on_time: Vec<(f64, f64, u32)> = neighbour_roots(plan, front, c)
                 .into_iter()
                 .filter(|&r| is_root(plan, r) && can_merge(plan, front, columns, r, c))
-                .map(|r| (late(plan, r), apart(r), r))
+                .map(|r| (late[r as usize], apart(r), r))
                 .filter(|&(l, _, _)| l <= OVERTAKEN)
                 .collect();
             on_time.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
@@ -626,18 +628,18 @@ pub(super) fn merge_to_mend(
     let base = |c: u32| columns.base[c as usize];
     let travel = |c: u32| plan.proposed[c as usize].distance(base(c));
     let near = |a: u32, b: u32| base(a).distance(base(b)) <= travel(a) + travel(b);
-    let (a, b) = (0..n.len()).map(|i| (n[i], n[(i + 1) % n.len()])).find(|&(a, b)| {
-        if !can_merge(plan, front, columns, a, b) || survivor(columns, a, b).2 || !near(a, b) {
-            return false;
+    let edges: Vec<(u32, u32)> =
+        (0..n.len()).map(|i| (n[i], n[(i + 1) % n.len()])).filter(|&(a, b)| near(a, b)).collect();
+    for (a, b) in edges {
+        if !can_merge(plan, front, columns, a, b) || survivor(columns, a, b).2 {
+            continue;
         }
-        let mut trial = plan.clone();
-        collapse(&mut trial, columns, a, b);
-        let merged: Vec<u32> = trial.merges.group(trial.merges.root(a)).collect();
-        invalid_cells(&trial, &merged) == 0
-    })?;
-    tracing::debug!(f, a, b, at = ?columns.base[a as usize], "invalid cell mended by a merge");
-    collapse(plan, columns, a, b);
-    Some(plan.merges.root(a))
+        if try_collapse(plan, columns, a, b, &|plan, group| invalid_cells(plan, group) == 0) {
+            tracing::debug!(f, a, b, at = ?columns.base[a as usize], "invalid cell mended by a merge");
+            return Some(plan.merges.root(a));
+        }
+    }
+    None
 }
 
 /// Which of roots `a` and `b` survives their merge, which goes, and whether the survivor
