@@ -622,8 +622,11 @@ impl TetMesh {
 
     /// Where to insert a point for tetrahedron `t`: over each of its boundary faces the best
     /// apex and, on a front triangle with a last layer under it, the point at that layer's
-    /// height over its centre; and its circumcentre. With each, whether the point is to stay
-    /// where it is (a matched apex moved to the best place would sink towards the front).
+    /// height over its centre; its circumcentre; and its centroid (the circumcentre of a flat
+    /// sliver is far away, often outside the region, while the centroid's cavity is small and
+    /// the point, once moved to its best place, splits the sliver). With each, whether the
+    /// point is to stay where it is (a matched apex moved to the best place would sink towards
+    /// the front).
     fn insertion_points(&self, t: u32) -> Vec<(DVec3, Placement)> {
         let mut points = Vec::new();
         for face in self.outward_faces(t) {
@@ -634,7 +637,9 @@ impl TetMesh {
             points.push((best_apex(a, c, b).0, Placement::Best));
             points.extend(self.matched_apex(t, face).map(|p| (p, Placement::AsGiven)));
         }
-        points.extend(circumcentre(self.corners(self.tets[t as usize])).map(|p| (p, Placement::Best)));
+        let corners = self.corners(self.tets[t as usize]);
+        points.extend(circumcentre(corners).map(|p| (p, Placement::Best)));
+        points.push((corners.iter().sum::<DVec3>() / 4.0, Placement::Best));
         points
     }
 
@@ -762,7 +767,10 @@ impl TetMesh {
         // Nearer the tetrahedron, the cavity is smaller and more often star-shaped.
         let centre = self.corners(tet).iter().sum::<DVec3>() / 4.0;
         insertions.extend(
-            points.iter().filter_map(|&(p, _)| self.insert_point(t, 0.5 * (p + centre), Placement::Best)),
+            points
+                .iter()
+                .filter(|&&(p, _)| p != centre)
+                .filter_map(|&(p, _)| self.insert_point(t, 0.5 * (p + centre), Placement::Best)),
         );
         let change = self.best_improving(insertions, rule)?;
         stats.inserted_points += 1;
