@@ -637,10 +637,14 @@ impl TetMesh {
             points.push((best_apex(a, c, b).0, Placement::Best));
             points.extend(self.matched_apex(t, face).map(|p| (p, Placement::AsGiven)));
         }
-        let corners = self.corners(self.tets[t as usize]);
-        points.extend(circumcentre(corners).map(|p| (p, Placement::Best)));
-        points.push((corners.iter().sum::<DVec3>() / 4.0, Placement::Best));
+        points.extend(circumcentre(self.corners(self.tets[t as usize])).map(|p| (p, Placement::Best)));
+        points.push((self.centroid(t), Placement::Best));
         points
+    }
+
+    /// The centroid of tetrahedron `t`.
+    fn centroid(&self, t: u32) -> DVec3 {
+        self.corners(self.tets[t as usize]).iter().sum::<DVec3>() / 4.0
     }
 
     /// Worst quality of `ball` (tetrahedra at `v`) with `v` at `p`.
@@ -765,7 +769,7 @@ impl TetMesh {
         let points = self.insertion_points(t);
         insertions.extend(points.iter().filter_map(|&(p, placement)| self.insert_point(t, p, placement)));
         // Nearer the tetrahedron, the cavity is smaller and more often star-shaped.
-        let centre = self.corners(tet).iter().sum::<DVec3>() / 4.0;
+        let centre = self.centroid(t);
         insertions.extend(
             points
                 .iter()
