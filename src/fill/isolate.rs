@@ -20,7 +20,10 @@ pub enum ChildEnd {
 /// Run `work` in a forked child and return the bytes it produced.
 ///
 /// The child runs only `work`, writes its bytes and leaves with `_exit` (no destructor, no
-/// flush of this process's buffers). `work` must not need the other threads of this process:
+/// flush of this process's buffers). It first closes every descriptor it inherited but the
+/// standard three and its pipe: an inherited copy would keep the parent's files, locks and
+/// pipes alive for as long as the child runs (HDF5's lock on a CGNS file another thread was
+/// writing made that file unreadable until the child ended). `work` must not need the other threads of this process:
 /// they do not exist in the child. glibc's `malloc` stays usable after `fork`.
 pub fn in_child(work: impl FnOnce() -> Vec<u8>) -> Result<Vec<u8>, ChildEnd> {
     let mut fds = [0 as c_int; 2];
@@ -34,7 +37,7 @@ pub fn in_child(work: impl FnOnce() -> Vec<u8>) -> Result<Vec<u8>, ChildEnd> {
     if pid == 0 {
         // SAFETY: the child's own descriptors; `bytes` outlives the writes from it.
         unsafe {
-            libc::close(read_end);
+            let write_end = keep_only_standard_descriptors_and(write_end);
             let bytes = work();
             let mut written = 0;
             while written < bytes.len() {
@@ -72,6 +75,30 @@ pub fn in_child(work: impl FnOnce() -> Vec<u8>) -> Result<Vec<u8>, ChildEnd> {
     }
 }
 
+/// In a just-forked child: move `pipe` to descriptor 3 and close every descriptor above it.
+/// Returns the pipe's new descriptor. Only async-signal-safe calls (the other threads' locks
+/// may be held).
+unsafe fn keep_only_standard_descriptors_and(pipe: c_int) -> c_int {
+    const KEPT: c_int = 3;
+    if pipe != KEPT && (libc::dup2(pipe, KEPT) != KEPT || libc::close(pipe) != 0) {
+        libc::_exit(2);
+    }
+    let first = (KEPT + 1) as libc::c_uint;
+    if libc::syscall(libc::SYS_close_range, first, libc::c_uint::MAX, 0 as libc::c_uint) != 0 {
+        // No close_range (Linux before 5.9): close them one by one up to the limit.
+        let mut limit = libc::rlimit { rlim_cur: 0, rlim_max: 0 };
+        let end = if libc::getrlimit(libc::RLIMIT_NOFILE, &mut limit) == 0 {
+            limit.rlim_cur.min(1 << 20) as c_int
+        } else {
+            1 << 16
+        };
+        for fd in KEPT + 1..end {
+            libc::close(fd);
+        }
+    }
+    KEPT
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -86,6 +113,24 @@ mod tests {
     #[test]
     fn a_child_that_aborts_is_an_error_not_the_end() {
         assert_eq!(in_child(|| std::process::abort()), Err(ChildEnd::Signal(libc::SIGABRT)));
+    }
+
+    /// The (device, inode) of the file open as `fd`, if it is open.
+    fn file_identity(fd: c_int) -> Option<(u64, u64)> {
+        // SAFETY: fstat writes into `stat` only.
+        let mut stat: libc::stat = unsafe { std::mem::zeroed() };
+        (unsafe { libc::fstat(fd, &mut stat) } == 0).then_some((stat.st_dev, stat.st_ino))
+    }
+
+    #[test]
+    fn the_child_holds_none_of_the_parents_files() {
+        let open = std::fs::File::open("Cargo.toml").unwrap();
+        let fd = std::os::fd::AsRawFd::as_raw_fd(&open);
+        let parent = file_identity(fd);
+        assert!(parent.is_some());
+        let child = in_child(move || vec![(file_identity(fd) == parent) as u8]);
+        assert_eq!(child, Ok(vec![0]), "the child still had Cargo.toml open as {fd}");
+        assert_eq!(file_identity(fd), parent, "the parent's copy stays open");
     }
 
     #[test]

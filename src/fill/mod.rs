@@ -11,7 +11,7 @@ pub mod farfield;
 mod front;
 pub mod improve;
 #[cfg(feature = "tetgen")]
-mod isolate;
+pub(crate) mod isolate;
 mod merge;
 pub mod seeds;
 pub mod size_jump;

@@ -512,3 +512,34 @@ impl Drop for File {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::fill::isolate::in_child;
+
+    /// HDF5 locks the file it writes (flock). A child forked meanwhile by another thread, as the
+    /// TetGen fill does, inherited that lock and kept the finished file unreadable until it ended.
+    #[test]
+    fn a_file_written_while_a_child_runs_can_be_read_at_once() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("locked.cgns");
+        let mut file = File::open(&path, MODE_WRITE).unwrap();
+        file.write_base("Base", 3, 3).unwrap();
+        let (forking, forked) = std::sync::mpsc::channel();
+        let child = std::thread::spawn(move || {
+            forking.send(()).unwrap();
+            in_child(|| {
+                std::thread::sleep(std::time::Duration::from_secs(2));
+                Vec::new()
+            })
+        });
+        forked.recv().unwrap();
+        std::thread::sleep(std::time::Duration::from_millis(200));
+        file.close().unwrap();
+        let mut back = File::open(&path, MODE_READ).expect("the child held the file's lock");
+        assert_eq!(back.base_count().unwrap(), 1);
+        drop(back);
+        assert_eq!(child.join().unwrap(), Ok(Vec::new()));
+    }
+}
