@@ -100,6 +100,8 @@ pub struct LayerSummary {
     /// with a few examples.
     pub stopped_vertices: usize,
     pub stopped_examples: Vec<[f64; 3]>,
+    /// The caps and folds of the final front, before and after tops were pulled back.
+    pub unfold: layers::unfold::UnfoldStats,
     /// Wall vertices whose column stopped at the medial surface of a thin gap.
     pub gap_limited_vertices: usize,
     pub smoothness: crate::layers::smoothness::Smoothness,
@@ -387,6 +389,7 @@ fn layer_summary(
             .map(|&v| surface.points[v as usize].to_array())
             .collect(),
         gap_limited_vertices: layered.gap_limited_vertices.len(),
+        unfold: layered.unfold.clone(),
         smoothness: layered.smoothness.clone(),
     }
 }
@@ -440,6 +443,12 @@ impl std::fmt::Display for MeshReport {
             )?;
         }
         writeln!(f)?;
+        let u = &l.unfold;
+        writeln!(
+            f,
+            "front     {} caps and folds after the march, {} tops pulled back, {} left",
+            u.defects_before, u.moved_tops, u.defects_after
+        )?;
         writeln!(
             f,
             "normals   {} columns ({} in fans over {} convex ridge edges, {} corner patches)",

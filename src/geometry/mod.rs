@@ -55,10 +55,21 @@ pub fn triangle_area_vector(a: DVec3, b: DVec3, c: DVec3) -> DVec3 {
     (b - a).cross(c - a)
 }
 
+/// The corner angles of triangle (a, b, c) at a, b and c, in degrees.
+fn triangle_angles(a: DVec3, b: DVec3, c: DVec3) -> [f64; 3] {
+    let corner = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p).to_degrees();
+    [corner(a, b, c), corner(b, c, a), corner(c, a, b)]
+}
+
 /// The smallest corner angle of triangle (a, b, c), in degrees.
 pub fn triangle_min_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
-    let corner = |p: DVec3, q: DVec3, r: DVec3| (q - p).angle_between(r - p).to_degrees();
-    corner(a, b, c).min(corner(b, c, a)).min(corner(c, a, b))
+    triangle_angles(a, b, c).into_iter().fold(f64::INFINITY, f64::min)
+}
+
+/// The largest corner angle of triangle (a, b, c), in degrees (near 180 for a cap: a corner
+/// nearly on the opposite edge).
+pub fn triangle_max_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
+    triangle_angles(a, b, c).into_iter().fold(f64::NEG_INFINITY, f64::max)
 }
 
 /// Signed volume of tetrahedron (a, b, c, d): positive when d lies on the side the right-hand

@@ -16,6 +16,7 @@ pub mod sliding;
 pub mod smoothness;
 pub mod split;
 pub mod swap;
+pub mod unfold;
 
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
@@ -52,6 +53,8 @@ pub struct Layers {
     /// ([`gap::gap_limited`]): their stacks are as thick as the gap allows.
     pub gap_limited_vertices: Vec<u32>,
     pub smoothness: smoothness::Smoothness,
+    /// The caps and folds of the final front, and the tops pulled back to undo them.
+    pub unfold: unfold::UnfoldStats,
 }
 
 /// Extrude the wall. `patch_spec[p]` is the layer stack of patch `p`, `None` for patches
@@ -86,6 +89,7 @@ pub fn build_layers(
     let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, &walls, |k| {
         on_layer(k, max_layers)
     });
+    let unfold = unfold::unfold_front(&mut mesh, &mut columns, &front, surface, layered);
     let front_edges = sizes.front_edge_lengths(&mesh.points, &columns, &front);
     add_boundary(&mut mesh, surface, &front, &columns);
     let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
@@ -133,6 +137,7 @@ pub fn build_layers(
         stopped_vertices,
         gap_limited_vertices,
         smoothness,
+        unfold,
     }
 }
 
