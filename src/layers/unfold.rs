@@ -15,6 +15,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 
 use super::front::{Columns, Front, NOT_MERGED};
+use super::guard::pyramid_apex;
 use crate::geometry::triangle_max_angle;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::normals::constraint::Slide;
@@ -41,19 +42,38 @@ pub struct UnfoldStats {
     pub moved_tops: usize,
 }
 
-/// The final front as triangles (quads split on a diagonal for the crossing test only), with
-/// the edges between them.
-struct FrontTriangles {
+/// The core's boundary over the layers as the fill will see it: the front's triangles and, for
+/// each quad, the four triangles of the pyramid the fill caps it with (its apex placed as the
+/// fill places it, [`pyramid_apex`]), with the edges between them.
+struct CoreFront {
+    /// The mesh's points, then each quad's apex.
+    points: Vec<DVec3>,
     /// Triangles, right-hand normals towards the core.
     triangles: Vec<[u32; 3]>,
+    quads: Vec<[u32; 4]>,
+    /// The first apex's point.
+    first_apex: usize,
+    /// For each node, the quads at it.
+    quads_at: HashMap<u32, Vec<u32>>,
     /// For each node, the triangles at it.
     at_node: HashMap<u32, Vec<u32>>,
     /// For each edge (sorted), the triangles on it.
     on_edge: HashMap<[u32; 2], Vec<u32>>,
 }
 
-impl FrontTriangles {
-    fn new(triangles: Vec<[u32; 3]>) -> FrontTriangles {
+impl CoreFront {
+    /// `None` when a quad cannot be capped (the fill would fail there whatever moves).
+    fn new(mut points: Vec<DVec3>, mut triangles: Vec<[u32; 3]>, quads: Vec<[u32; 4]>) -> Option<CoreFront> {
+        let first_apex = points.len();
+        let mut quads_at: HashMap<u32, Vec<u32>> = HashMap::new();
+        for (q, quad) in quads.iter().enumerate() {
+            points.push(pyramid_apex(quad.map(|n| points[n as usize]))?);
+            let apex = (first_apex + q) as u32;
+            for i in 0..4 {
+                triangles.push([quad[i], quad[(i + 1) % 4], apex]);
+                quads_at.entry(quad[i]).or_default().push(q as u32);
+            }
+        }
         let mut at_node: HashMap<u32, Vec<u32>> = HashMap::new();
         let mut on_edge: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
         for (t, tri) in triangles.iter().enumerate() {
@@ -62,54 +82,114 @@ impl FrontTriangles {
                 on_edge.entry(sorted(tri[i], tri[(i + 1) % 3])).or_default().push(t as u32);
             }
         }
-        FrontTriangles { triangles, at_node, on_edge }
+        Some(CoreFront { points, triangles, quads, first_apex, quads_at, at_node, on_edge })
     }
 
-    /// How far the triangles at `v`, and the edges of them, are from being a cap or a fold:
-    /// the smallest of 180 less the largest angle and of the core-side angles (degrees).
-    fn quality_at(&self, points: &[DVec3], v: u32) -> f64 {
-        let Some(around) = self.at_node.get(&v) else { return 180.0 };
+    /// The largest angle of triangle `t` with its nodes at `at` (`None` where one has none).
+    fn cap_angle_at(&self, t: u32, at: impl Fn(u32) -> Option<DVec3>) -> Option<f64> {
+        let [a, b, c] = self.triangles[t as usize].map(&at);
+        Some(triangle_max_angle(a?, b?, c?))
+    }
+
+    fn here(&self) -> impl Fn(u32) -> Option<DVec3> + '_ {
+        |n| Some(self.points[n as usize])
+    }
+
+    fn is_cap(&self, t: u32) -> bool {
+        self.cap_angle_at(t, self.here()).is_some_and(|a| a > CAP_ANGLE)
+    }
+
+    fn core_angle(&self, edge: [u32; 2]) -> f64 {
+        self.core_angle_at(edge, self.here()).unwrap_or(180.0)
+    }
+
+    /// Put node `v` at `p`, with the apexes of its quads; `false` (and nothing moved) when a
+    /// quad of it could not be capped there.
+    fn move_node(&mut self, v: u32, p: DVec3) -> bool {
+        let old = self.points[v as usize];
+        self.points[v as usize] = p;
+        let quads = self.quads_at.get(&v).cloned().unwrap_or_default();
+        let mut apexes = Vec::with_capacity(quads.len());
+        for &q in &quads {
+            match pyramid_apex(self.quads[q as usize].map(|n| self.points[n as usize])) {
+                Some(apex) => apexes.push(apex),
+                None => {
+                    self.points[v as usize] = old;
+                    return false;
+                }
+            }
+        }
+        for (&q, apex) in quads.iter().zip(apexes) {
+            self.points[self.first_apex + q as usize] = apex;
+        }
+        true
+    }
+
+    /// The triangles a move of node `v` changes: those at it and at its quads' apexes.
+    fn triangles_moved_by(&self, v: u32) -> Vec<u32> {
+        let apexes =
+            self.quads_at.get(&v).into_iter().flatten().map(|&q| (self.first_apex + q as usize) as u32);
+        let mut around: Vec<u32> = std::iter::once(v)
+            .chain(apexes)
+            .flat_map(|n| self.at_node.get(&n).into_iter().flatten().copied())
+            .collect();
+        around.sort_unstable();
+        around.dedup();
+        around
+    }
+
+    /// How far the triangles a move of `v` changes, and their edges, are from being a cap or
+    /// a fold: the smallest of 180 less the largest angle and of the core-side angles (degrees).
+    fn quality_at(&self, v: u32) -> f64 {
         let mut worst = 180.0f64;
-        for &t in around {
+        for t in self.triangles_moved_by(v) {
+            worst = worst.min(180.0 - self.cap_angle_at(t, self.here()).unwrap_or(0.0));
             let tri = self.triangles[t as usize];
-            let [a, b, c] = tri.map(|n| points[n as usize]);
-            worst = worst.min(180.0 - triangle_max_angle(a, b, c));
             for i in 0..3 {
-                worst = worst.min(self.core_angle(points, sorted(tri[i], tri[(i + 1) % 3])));
+                worst = worst.min(self.core_angle(sorted(tri[i], tri[(i + 1) % 3])));
             }
         }
         worst
     }
 
-    /// The angle (degrees) on the core's side between the two triangles on `edge`; 180 for an
-    /// edge with another number of triangles.
-    fn core_angle(&self, points: &[DVec3], edge: [u32; 2]) -> f64 {
-        let Some(&[s, t]) = self.on_edge.get(&edge).map(Vec::as_slice) else { return 180.0 };
+    /// The angle (degrees) on the core's side between the two triangles on `edge`, with the
+    /// nodes at `at`: 180 for an edge with another number of triangles, `None` where a node has
+    /// no position.
+    fn core_angle_at(&self, edge: [u32; 2], at: impl Fn(u32) -> Option<DVec3>) -> Option<f64> {
+        let Some(&[s, t]) = self.on_edge.get(&edge).map(Vec::as_slice) else { return Some(180.0) };
         let opposite = |t: u32| self.triangles[t as usize].into_iter().find(|n| !edge.contains(n));
-        let (Some(c), Some(d)) = (opposite(s), opposite(t)) else { return 180.0 };
-        let [a, b, c, d] = [edge[0], edge[1], c, d].map(|n| points[n as usize]);
+        let (Some(c), Some(d)) = (opposite(s), opposite(t)) else { return Some(180.0) };
+        let [a, b, c, d] = [edge[0], edge[1], c, d].map(&at);
+        let (a, b, c, d) = (a?, b?, c?, d?);
         let axis = (b - a).normalize_or_zero();
         let across = |p: DVec3| {
             let q = p - a;
             (q - axis * q.dot(axis)).normalize_or_zero()
         };
-        let (u, w) = (across(c), across(d));
-        let angle = u.angle_between(w).to_degrees();
-        let [x, y, z] = self.triangles[s as usize].map(|n| points[n as usize]);
-        let normal = (y - x).cross(z - x);
-        // `d` on the core's side of `s`: the front turns away from the core (a valley).
-        if normal.dot(d - a) > 0.0 {
-            angle
-        } else {
-            360.0 - angle
-        }
+        let angle = across(c).angle_between(across(d)).to_degrees();
+        let [x, y, z] = self.triangles[s as usize].map(&at);
+        let (x, y, z) = (x?, y?, z?);
+        // `d` on the core's side of `s`: the front turns towards the core (a valley).
+        Some(if (y - x).cross(z - x).dot(d - a) > 0.0 { angle } else { 360.0 - angle })
     }
 
-    fn is_defect(&self, points: &[DVec3], t: u32) -> bool {
+    /// Whether triangle `t` is a cap or on a fold.
+    fn is_defect(&self, t: u32) -> bool {
         let tri = self.triangles[t as usize];
-        let [a, b, c] = tri.map(|n| points[n as usize]);
-        triangle_max_angle(a, b, c) > CAP_ANGLE
-            || (0..3).any(|i| self.core_angle(points, sorted(tri[i], tri[(i + 1) % 3])) < FOLD_ANGLE)
+        self.is_cap(t) || (0..3).any(|i| self.core_angle(sorted(tri[i], tri[(i + 1) % 3])) < FOLD_ANGLE)
+    }
+
+    /// The corners of the quads whose apexes are among `nodes` (a corner's move moves its apex).
+    fn quad_corners_of_apexes(&self, nodes: [u32; 3]) -> Vec<u32> {
+        nodes
+            .iter()
+            .filter_map(|&n| (n as usize).checked_sub(self.first_apex))
+            .flat_map(|q| self.quads[q])
+            .collect()
+    }
+
+    fn defects(&self) -> usize {
+        (0..self.triangles.len() as u32).filter(|&t| self.is_defect(t)).count()
     }
 }
 
@@ -131,31 +211,30 @@ pub fn unfold_front(
     surface: &Surface,
     layered: impl Fn(u32) -> bool,
 ) -> UnfoldStats {
-    let (front_triangles, quad_nodes) = final_front(front, columns);
-    let triangles = FrontTriangles::new(front_triangles);
-    let defects = |points: &[DVec3]| {
-        (0..triangles.triangles.len() as u32).filter(|&t| triangles.is_defect(points, t)).count()
+    let (triangles, quads) = final_front(front, columns);
+    let Some(mut core_front) = CoreFront::new(mesh.points.clone(), triangles, quads) else {
+        return UnfoldStats::default();
     };
-    let mut stats = UnfoldStats { defects_before: defects(&mesh.points), ..Default::default() };
+    let mut stats = UnfoldStats { defects_before: core_front.defects(), ..Default::default() };
     if stats.defects_before == 0 {
-        stats.defects_after = 0;
         return stats;
     }
-    let tops = movable_tops(columns, &quad_nodes);
+    let tops = movable_tops(columns);
     let cells = cells_at(mesh, &tops);
     let mut moved: HashMap<u32, (DVec3, f64)> = HashMap::new();
     for _ in 0..ROUNDS {
         let mut changed = false;
-        for t in 0..triangles.triangles.len() as u32 {
-            if !triangles.is_defect(&mesh.points, t) {
+        for t in 0..core_front.triangles.len() as u32 {
+            if !core_front.is_defect(t) {
                 continue;
             }
-            for v in triangles.triangles[t as usize] {
+            for v in core_front.triangles[t as usize] {
                 let Some(&c) = tops.get(&v) else { continue };
-                if let Some(pull) = best_pull_back(mesh, columns, &triangles, &cells[&v], v, c) {
-                    let old = mesh.points[v as usize];
+                if let Some(pull) = best_pull_back(&mut core_front, columns, &cells[&v], v, c) {
+                    let old = core_front.points[v as usize];
                     moved.entry(v).or_insert((old, columns.last_step[c]));
-                    mesh.points[v as usize] = old - columns.dir[c] * pull;
+                    let moves = core_front.move_node(v, old - columns.dir[c] * pull);
+                    debug_assert!(moves, "a pull-back tried and capped");
                     columns.last_step[c] -= pull;
                     changed = true;
                 }
@@ -165,36 +244,34 @@ pub fn unfold_front(
             break;
         }
     }
-    undo_crossing_moves(mesh, columns, &triangles, &tops, &mut moved, surface, layered);
+    undo_crossing_moves(&mut core_front, columns, &tops, &mut moved, surface, layered);
+    for &v in moved.keys() {
+        mesh.points[v as usize] = core_front.points[v as usize];
+    }
     stats.moved_tops = moved.len();
-    stats.defects_after = defects(&mesh.points);
+    stats.defects_after = core_front.defects();
     stats
 }
 
-/// The final front's triangles (the tops of the front's faces, their normals towards the core;
-/// quads split on a diagonal) and the nodes of its quads (the fill caps a quad with a pyramid
-/// whose apex depends on them: they stay).
-fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<u32>) {
+/// The final front: the tops of the front's faces as triangles and quads (normals towards the
+/// core), as [`super::add_boundary`] makes its top patch.
+fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]>) {
     let mut triangles = Vec::new();
-    let mut quad_nodes = Vec::new();
+    let mut quads = Vec::new();
     for f in 0..front.len() {
         let nodes: Vec<u32> = front.face_columns(f).iter().map(|&c| columns.node[c as usize]).collect();
         match super::slab::Polygon::dedup(&nodes).as_ref().map(|p| p.nodes()) {
             Some(&[a, b, c]) => triangles.push([a, b, c]),
-            Some(&[a, b, c, d]) => {
-                triangles.extend([[a, b, c], [a, c, d]]);
-                quad_nodes.extend([a, b, c, d]);
-            }
+            Some(&[a, b, c, d]) => quads.push([a, b, c, d]),
             _ => {}
         }
     }
-    (triangles, quad_nodes)
+    (triangles, quads)
 }
 
 /// The tops that may move, with their column: above the wall, of the one column ending there
-/// that did not merge (the others merged into it), free to move anywhere, on no quad of the
-/// front (the fill caps a quad with a pyramid whose apex depends on its corners).
-fn movable_tops(columns: &Columns, quad_nodes: &[u32]) -> HashMap<u32, usize> {
+/// that did not merge (the others merged into it), free to move anywhere.
+fn movable_tops(columns: &Columns) -> HashMap<u32, usize> {
     let mut ending: HashMap<u32, Vec<usize>> = HashMap::new();
     for c in (0..columns.len()).filter(|&c| columns.merged_into[c] == NOT_MERGED) {
         ending.entry(columns.node[c]).or_default().push(c);
@@ -202,11 +279,7 @@ fn movable_tops(columns: &Columns, quad_nodes: &[u32]) -> HashMap<u32, usize> {
     ending
         .into_iter()
         .filter_map(|(v, at)| match at[..] {
-            [c] if columns.layers[c] > 0
-                && columns.slide[c] == Slide::Free
-                && columns.last_step[c] > 0.0
-                && !quad_nodes.contains(&v) =>
-            {
+            [c] if columns.layers[c] > 0 && columns.slide[c] == Slide::Free && columns.last_step[c] > 0.0 => {
                 Some((v, c))
             }
             _ => None,
@@ -228,72 +301,76 @@ fn cells_at(mesh: &VolumeMesh, tops: &HashMap<u32, usize>) -> HashMap<u32, Vec<(
 }
 
 /// The pull-back of top `v` (column `c`) along its last step that best raises the quality of
-/// the front around it, keeping every cell at it valid; `None` when none raises it.
+/// the front around it, keeping every cell at it valid and its quads cappable; `None` when
+/// none raises it by a degree.
 fn best_pull_back(
-    mesh: &mut VolumeMesh,
+    front: &mut CoreFront,
     columns: &Columns,
-    triangles: &FrontTriangles,
     cells: &[(CellKind, Vec<u32>)],
     v: u32,
     c: usize,
 ) -> Option<f64> {
-    let start = mesh.points[v as usize];
-    let mut best = (triangles.quality_at(&mesh.points, v) + 1.0, None);
+    let start = front.points[v as usize];
+    let mut best = (front.quality_at(v) + 1.0, None);
     for part in PULL_BACKS {
         let pull = part * columns.last_step[c];
-        mesh.points[v as usize] = start - columns.dir[c] * pull;
+        if !front.move_node(v, start - columns.dir[c] * pull) {
+            continue;
+        }
         let valid = cells.iter().all(|(kind, nodes)| {
             let mut x: CellPoints = [DVec3::ZERO; 8];
             for (xi, &n) in x.iter_mut().zip(nodes) {
-                *xi = mesh.points[n as usize];
+                *xi = front.points[n as usize];
             }
             cell_validity(*kind, &x).is_valid()
         });
-        let quality = triangles.quality_at(&mesh.points, v);
+        let quality = front.quality_at(v);
         if valid && quality > best.0 {
             best = (quality, Some(pull));
         }
     }
-    mesh.points[v as usize] = start;
+    let restored = front.move_node(v, start);
+    debug_assert!(restored, "the start was cappable");
     best.1
 }
 
-/// Undo the moves of tops whose front triangles now cross the front or a wall without layers
-/// (exact tests), until none does: the march left a front that crosses nothing.
+/// Undo the moves of tops whose triangles now cross the core's boundary (the front, its quads'
+/// caps, the walls without layers; exact tests), until none does: the march left a front that
+/// crosses nothing.
 fn undo_crossing_moves(
-    mesh: &mut VolumeMesh,
+    front: &mut CoreFront,
     columns: &mut Columns,
-    triangles: &FrontTriangles,
     tops: &HashMap<u32, usize>,
     moved: &mut HashMap<u32, (DVec3, f64)>,
     surface: &Surface,
     layered: impl Fn(u32) -> bool,
 ) {
-    let mut soup: Vec<[u32; 3]> = triangles.triangles.clone();
-    // The walls without layers, their nodes numbered as in the mesh (the wall's points come
-    // first in it).
+    let mut soup = front.triangles.clone();
+    // The walls without layers: their nodes are the wall's, the mesh's first points.
     soup.extend(
         (0..surface.triangles.len())
             .filter(|&t| !layered(surface.triangle_patch[t]))
             .map(|t| surface.triangles[t]),
     );
-    loop {
-        if moved.is_empty() {
-            return;
-        }
+    while !moved.is_empty() {
         let check = Surface {
-            points: mesh.points.clone(),
+            points: front.points.clone(),
             triangles: soup.clone(),
             triangle_patch: vec![0; soup.len()],
             patch_names: vec![String::new()],
         };
-        let queries: Vec<u32> =
-            moved.keys().flat_map(|v| triangles.at_node.get(v).into_iter().flatten().copied()).collect();
+        let queries: Vec<u32> = moved.keys().flat_map(|&v| front.triangles_moved_by(v)).collect();
         let pairs = crate::surface::validate::intersecting_pairs_with(&check, &queries, false);
         let mut undo: Vec<u32> = pairs
             .iter()
             .flat_map(|&(s, t)| [s, t])
             .flat_map(|t| soup[t as usize])
+            .chain(
+                pairs
+                    .iter()
+                    .flat_map(|&(s, t)| [s, t])
+                    .flat_map(|t| front.quad_corners_of_apexes(soup[t as usize])),
+            )
             .filter(|v| moved.contains_key(v))
             .collect();
         undo.sort_unstable();
@@ -303,7 +380,8 @@ fn undo_crossing_moves(
         }
         for v in undo {
             let (position, step) = moved.remove(&v).expect("a moved top");
-            mesh.points[v as usize] = position;
+            let moves = front.move_node(v, position);
+            debug_assert!(moves, "the march's position was cappable");
             columns.last_step[tops[&v]] = step;
         }
     }
@@ -313,38 +391,50 @@ fn undo_crossing_moves(
 mod tests {
     use super::*;
 
-    /// Two triangles on the edge (0, 1) along x, normals up (+z, the core's side), the second
+    /// Two triangles on the edge (0, 1) along x, normals up (+z, the core's side), the first
     /// one's far corner at `d`.
-    fn pair(d: DVec3) -> (Vec<DVec3>, FrontTriangles) {
+    fn pair(d: DVec3) -> CoreFront {
         let points = vec![DVec3::ZERO, DVec3::X, DVec3::new(0.5, -1.0, 0.0), d];
-        (points, FrontTriangles::new(vec![[0, 1, 3], [1, 0, 2]]))
+        CoreFront::new(points, vec![[0, 1, 3], [1, 0, 2]], Vec::new()).unwrap()
     }
 
     #[test]
     fn the_core_angle_is_180_on_a_plane_small_in_a_valley_and_large_on_a_ridge() {
-        let angle = |d: DVec3| {
-            let (points, front) = pair(d);
-            front.core_angle(&points, [0, 1])
-        };
+        let angle = |d: DVec3| pair(d).core_angle([0, 1]);
         assert!((angle(DVec3::new(0.5, 1.0, 0.0)) - 180.0).abs() < 1e-9);
-        // The second triangle turned up towards the core: a valley of 45 degrees.
-        assert!(
-            (angle(DVec3::new(0.5, -1.0, 1.0).normalize() + DVec3::new(0.5, 0.0, 0.0)) - 45.0).abs() < 1e-6
-        );
+        // The first triangle turned up and over towards the core: a valley of 45 degrees.
+        let up = DVec3::new(0.5, -1.0, 1.0).normalize() + DVec3::new(0.5, 0.0, 0.0);
+        assert!((angle(up) - 45.0).abs() < 1e-6);
         assert!((angle(DVec3::new(0.5, 1.0, -1.0)) - 225.0).abs() < 1e-6);
-        // Folded back over the first one, nearly flat: a fold.
-        let (points, front) = pair(DVec3::new(0.5, -1.0, 0.05));
-        assert!(front.core_angle(&points, [0, 1]) < FOLD_ANGLE);
-        assert!(front.is_defect(&points, 0) && front.is_defect(&points, 1));
-        assert!(front.quality_at(&points, 3) < FOLD_ANGLE);
+        // Folded back over the second one, nearly flat: a fold.
+        let folded = pair(DVec3::new(0.5, -1.0, 0.05));
+        assert!(folded.core_angle([0, 1]) < FOLD_ANGLE);
+        assert!(folded.is_defect(0) && folded.is_defect(1));
+        assert!(folded.quality_at(3) < FOLD_ANGLE);
     }
 
     #[test]
     fn a_corner_on_the_opposite_edge_is_a_cap() {
-        let (mut points, front) = pair(DVec3::new(0.5, 1.0, 0.0));
-        assert!(!front.is_defect(&points, 0));
-        points[3] = DVec3::new(0.5, 0.01, 0.0);
-        assert!(front.is_defect(&points, 0), "a 178-degree corner");
-        assert!(front.quality_at(&points, 3) < 180.0 - CAP_ANGLE);
+        let mut front = pair(DVec3::new(0.5, 1.0, 0.0));
+        assert_eq!(front.defects(), 0);
+        assert!(front.move_node(3, DVec3::new(0.5, 0.01, 0.0)));
+        assert!(front.is_defect(0), "a 178-degree corner");
+        assert!(front.quality_at(3) < 180.0 - CAP_ANGLE);
+    }
+
+    #[test]
+    fn a_quad_is_seen_as_its_pyramid_cap_and_its_apex_follows_its_corners() {
+        let square = vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        let mut front = CoreFront::new(square, Vec::new(), vec![[0, 1, 2, 3]]).unwrap();
+        assert_eq!(front.triangles.len(), 4);
+        let apex = front.points[front.first_apex];
+        assert!((apex - DVec3::new(0.5, 0.5, 0.5)).length() < 1e-12, "{apex:?}");
+        assert_eq!(front.triangles_moved_by(0).len(), 4, "every cap triangle moves with the apex");
+        assert!(front.move_node(2, DVec3::new(2.0, 2.0, 0.0)));
+        assert!(front.points[front.first_apex].x > 0.5, "the apex moved with the corner");
+        // A corner moved onto another makes a quad no pyramid caps: refused, nothing moves.
+        assert!(!front.move_node(2, DVec3::ZERO));
+        assert_eq!(front.points[2], DVec3::new(2.0, 2.0, 0.0));
+        assert_eq!(front.quad_corners_of_apexes([0, 1, front.first_apex as u32]), vec![0, 1, 2, 3]);
     }
 }
