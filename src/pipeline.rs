@@ -446,8 +446,8 @@ impl std::fmt::Display for MeshReport {
         let u = &l.unfold;
         writeln!(
             f,
-            "front     {} caps and folds after the march, {} tops pulled back, {} left",
-            u.defects_before, u.moved_tops, u.defects_after
+            "front     {} caps and folds after the march, {} tops pulled back ({} more undone: they crossed the front), {} left",
+            u.defects_before, u.moved_tops, u.undone_moves, u.defects_after
         )?;
         writeln!(
             f,

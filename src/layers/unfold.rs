@@ -40,6 +40,8 @@ pub struct UnfoldStats {
     pub defects_after: usize,
     /// Column tops pulled back.
     pub moved_tops: usize,
+    /// Tops whose move was undone: their triangles crossed the core's boundary.
+    pub undone_moves: usize,
 }
 
 /// The core's boundary over the layers as the fill will see it: the front's triangles and, for
@@ -244,7 +246,7 @@ pub fn unfold_front(
             break;
         }
     }
-    undo_crossing_moves(&mut core_front, columns, &tops, &mut moved, surface, layered);
+    stats.undone_moves = undo_crossing_moves(&mut core_front, columns, &tops, &mut moved, surface, layered);
     for &v in moved.keys() {
         mesh.points[v as usize] = core_front.points[v as usize];
     }
@@ -336,7 +338,7 @@ fn best_pull_back(
 
 /// Undo the moves of tops whose triangles now cross the core's boundary (the front, its quads'
 /// caps, the walls without layers; exact tests), until none does: the march left a front that
-/// crosses nothing.
+/// crosses nothing. Returns how many moves were undone.
 fn undo_crossing_moves(
     front: &mut CoreFront,
     columns: &mut Columns,
@@ -344,7 +346,8 @@ fn undo_crossing_moves(
     moved: &mut HashMap<u32, (DVec3, f64)>,
     surface: &Surface,
     layered: impl Fn(u32) -> bool,
-) {
+) -> usize {
+    let mut undone = 0;
     let mut soup = front.triangles.clone();
     // The walls without layers: their nodes are the wall's, the mesh's first points.
     soup.extend(
@@ -376,8 +379,9 @@ fn undo_crossing_moves(
         undo.sort_unstable();
         undo.dedup();
         if undo.is_empty() {
-            return;
+            break;
         }
+        undone += undo.len();
         for v in undo {
             let (position, step) = moved.remove(&v).expect("a moved top");
             let moves = front.move_node(v, position);
@@ -385,6 +389,7 @@ fn undo_crossing_moves(
             columns.last_step[tops[&v]] = step;
         }
     }
+    undone
 }
 
 #[cfg(test)]
