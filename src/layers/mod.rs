@@ -258,8 +258,7 @@ fn add_boundary(mesh: &mut VolumeMesh, surface: &Surface, front: &front::Front, 
         if !front.raised[f] {
             continue;
         }
-        let nodes: Vec<u32> = front.face_columns(f).iter().map(|&c| columns.node[c as usize]).collect();
-        match crate::layers::slab::Polygon::dedup(&nodes).as_ref().map(|p| p.nodes()) {
+        match top_polygon(front, columns, f).as_ref().map(|p| p.nodes()) {
             Some(&[a, b, c]) => {
                 mesh.boundary.triangles.push([a, b, c]);
                 mesh.boundary.triangle_patch.push(top_patch);
@@ -271,4 +270,11 @@ fn add_boundary(mesh: &mut VolumeMesh, surface: &Surface, front: &front::Front, 
             _ => {}
         }
     }
+}
+
+/// The top of front face `f` where the columns are now: its distinct nodes (a triangle or a
+/// quad; `None` when merges left fewer than three).
+fn top_polygon(front: &front::Front, columns: &front::Columns, f: usize) -> Option<slab::Polygon> {
+    let nodes: Vec<u32> = front.face_columns(f).iter().map(|&c| columns.node[c as usize]).collect();
+    slab::Polygon::dedup(&nodes)
 }

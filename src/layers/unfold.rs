@@ -255,14 +255,13 @@ pub fn unfold_front(
     stats
 }
 
-/// The final front: the tops of the front's faces as triangles and quads (normals towards the
-/// core), as [`super::add_boundary`] makes its top patch.
+/// The final front: the tops of the front's faces (wall faces where they did not rise) as
+/// triangles and quads, normals towards the core.
 fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]>) {
     let mut triangles = Vec::new();
     let mut quads = Vec::new();
     for f in 0..front.len() {
-        let nodes: Vec<u32> = front.face_columns(f).iter().map(|&c| columns.node[c as usize]).collect();
-        match super::slab::Polygon::dedup(&nodes).as_ref().map(|p| p.nodes()) {
+        match super::top_polygon(front, columns, f).as_ref().map(|p| p.nodes()) {
             Some(&[a, b, c]) => triangles.push([a, b, c]),
             Some(&[a, b, c, d]) => quads.push([a, b, c, d]),
             _ => {}
@@ -364,16 +363,11 @@ fn undo_crossing_moves(
         };
         let queries: Vec<u32> = moved.keys().flat_map(|&v| front.triangles_moved_by(v)).collect();
         let pairs = crate::surface::validate::intersecting_pairs_with(&check, &queries, false);
+        // A crossing triangle's moved corners go back, and those of the quad whose cap it is.
         let mut undo: Vec<u32> = pairs
             .iter()
-            .flat_map(|&(s, t)| [s, t])
-            .flat_map(|t| soup[t as usize])
-            .chain(
-                pairs
-                    .iter()
-                    .flat_map(|&(s, t)| [s, t])
-                    .flat_map(|t| front.quad_corners_of_apexes(soup[t as usize])),
-            )
+            .flat_map(|&(s, t)| [soup[s as usize], soup[t as usize]])
+            .flat_map(|tri| tri.into_iter().chain(front.quad_corners_of_apexes(tri)))
             .filter(|v| moved.contains_key(v))
             .collect();
         undo.sort_unstable();
