@@ -271,7 +271,10 @@ fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]
 }
 
 /// The tops that may move, with their column: above the wall, of the one column ending there
-/// that did not merge (the others merged into it), free to move anywhere.
+/// that did not merge (the others merged into it), free to move anywhere, and short of its full
+/// stack or beyond it (in its transition layers): a stack that ends at its full count ends on
+/// the exact offset, which a pull-back would leave (a V groove's bisector tops by 15% of the
+/// thickness).
 fn movable_tops(columns: &Columns) -> HashMap<u32, usize> {
     let mut ending: HashMap<u32, Vec<usize>> = HashMap::new();
     for c in (0..columns.len()).filter(|&c| columns.merged_into[c] == NOT_MERGED) {
@@ -280,7 +283,11 @@ fn movable_tops(columns: &Columns) -> HashMap<u32, usize> {
     ending
         .into_iter()
         .filter_map(|(v, at)| match at[..] {
-            [c] if columns.layers[c] > 0 && columns.slide[c] == Slide::Free && columns.last_step[c] > 0.0 => {
+            [c] if columns.layers[c] > 0
+                && columns.full_count(c) != Some(columns.layers[c])
+                && columns.slide[c] == Slide::Free
+                && columns.last_step[c] > 0.0 =>
+            {
                 Some((v, c))
             }
             _ => None,
