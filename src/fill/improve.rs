@@ -22,7 +22,7 @@ use super::{sorted_triangle, ClosedBoundary, CoreTets, MARKER_FARFIELD, MARKER_F
 use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::{triangle_area_vector, DVec3};
-use crate::mesh::CellKind;
+use crate::mesh::{sorted_edge, CellKind};
 use crate::quality::measures::{dihedral_range, edge_face_pairs};
 
 /// Quality of a flat or inverted tetrahedron: below every real angle.
@@ -1101,10 +1101,6 @@ impl SliverCensus {
         }
         census
     }
-}
-
-fn sorted_edge(a: u32, b: u32) -> [u32; 2] {
-    [a.min(b), a.max(b)]
 }
 
 /// The angle of the region (sum of the dihedral angles of the tetrahedra of `core` there,

@@ -23,8 +23,9 @@ pub enum ChildEnd {
 /// flush of this process's buffers). It first closes every descriptor it inherited but the
 /// standard three and its pipe: an inherited copy would keep the parent's files, locks and
 /// pipes alive for as long as the child runs (HDF5's lock on a CGNS file another thread was
-/// writing made that file unreadable until the child ended). `work` must not need the other threads of this process:
-/// they do not exist in the child. glibc's `malloc` stays usable after `fork`.
+/// writing made that file unreadable until the child ended). `work` must not need the other
+/// threads of this process: they do not exist in the child. glibc's `malloc` stays usable
+/// after `fork`.
 pub fn in_child(work: impl FnOnce() -> Vec<u8>) -> Result<Vec<u8>, ChildEnd> {
     let mut fds = [0 as c_int; 2];
     // SAFETY: `fds` has room for the two descriptors pipe() writes.

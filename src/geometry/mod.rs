@@ -72,6 +72,22 @@ pub fn triangle_max_angle(a: DVec3, b: DVec3, c: DVec3) -> f64 {
     triangle_angles(a, b, c).into_iter().fold(f64::NEG_INFINITY, f64::max)
 }
 
+/// Signed turn in degrees across the edge shared by triangles `first` and `second`, whose corner
+/// off that edge is `far`. The angle is that between the two right-hand normals (atan2 of their
+/// cross and dot products: accurate near 0 and 180); the sign is exact: positive (convex) when
+/// `far` lies behind the plane of `first`, zero when it lies in it.
+pub fn signed_turn_deg(first: [DVec3; 3], second: [DVec3; 3], far: DVec3) -> f64 {
+    let [a, b, c] = first;
+    let sign = match predicates::orient3d(a, b, c, far) {
+        predicates::Sign::Negative => 1.0,
+        predicates::Sign::Positive => -1.0,
+        predicates::Sign::Zero => return 0.0,
+    };
+    let n1 = triangle_area_vector(a, b, c);
+    let n2 = triangle_area_vector(second[0], second[1], second[2]);
+    sign * n1.cross(n2).length().atan2(n1.dot(n2)).to_degrees()
+}
+
 /// Signed volume of tetrahedron (a, b, c, d): positive when d lies on the side the right-hand
 /// normal of (a, b, c) points to (the Gmsh/VTK convention for a valid tetrahedron).
 pub fn tet_signed_volume(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {

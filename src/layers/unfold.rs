@@ -16,11 +16,11 @@ use glam::DVec3;
 
 use super::front::{Columns, Front, NOT_MERGED};
 use super::guard::pyramid_apex;
-use crate::geometry::triangle_max_angle;
-use crate::mesh::{CellKind, VolumeMesh};
+use crate::geometry::{signed_turn_deg, triangle_max_angle};
+use crate::mesh::{sorted_edge, CellKind, VolumeMesh};
 use crate::normals::constraint::Slide;
-use crate::quality::measures::CellPoints;
-use crate::quality::validity::cell_validity;
+use crate::quality::validity::{cell_validity, gather};
+use crate::surface::topology::opposite_vertex;
 use crate::surface::Surface;
 
 /// A front triangle whose largest angle is above this (degrees) is a cap...
@@ -81,28 +81,19 @@ impl CoreFront {
         for (t, tri) in triangles.iter().enumerate() {
             for i in 0..3 {
                 at_node.entry(tri[i]).or_default().push(t as u32);
-                on_edge.entry(sorted(tri[i], tri[(i + 1) % 3])).or_default().push(t as u32);
+                on_edge.entry(sorted_edge(tri[i], tri[(i + 1) % 3])).or_default().push(t as u32);
             }
         }
         Some(CoreFront { points, triangles, quads, first_apex, quads_at, at_node, on_edge })
     }
 
-    /// The largest angle of triangle `t` with its nodes at `at` (`None` where one has none).
-    fn cap_angle_at(&self, t: u32, at: impl Fn(u32) -> Option<DVec3>) -> Option<f64> {
-        let [a, b, c] = self.triangles[t as usize].map(&at);
-        Some(triangle_max_angle(a?, b?, c?))
+    fn corners(&self, t: u32) -> [DVec3; 3] {
+        self.triangles[t as usize].map(|n| self.points[n as usize])
     }
 
-    fn here(&self) -> impl Fn(u32) -> Option<DVec3> + '_ {
-        |n| Some(self.points[n as usize])
-    }
-
-    fn is_cap(&self, t: u32) -> bool {
-        self.cap_angle_at(t, self.here()).is_some_and(|a| a > CAP_ANGLE)
-    }
-
-    fn core_angle(&self, edge: [u32; 2]) -> f64 {
-        self.core_angle_at(edge, self.here()).unwrap_or(180.0)
+    fn cap_angle(&self, t: u32) -> f64 {
+        let [a, b, c] = self.corners(t);
+        triangle_max_angle(a, b, c)
     }
 
     /// Put node `v` at `p`, with the apexes of its quads; `false` (and nothing moved) when a
@@ -145,40 +136,29 @@ impl CoreFront {
     fn quality_at(&self, v: u32) -> f64 {
         let mut worst = 180.0f64;
         for t in self.triangles_moved_by(v) {
-            worst = worst.min(180.0 - self.cap_angle_at(t, self.here()).unwrap_or(0.0));
+            worst = worst.min(180.0 - self.cap_angle(t));
             let tri = self.triangles[t as usize];
             for i in 0..3 {
-                worst = worst.min(self.core_angle(sorted(tri[i], tri[(i + 1) % 3])));
+                worst = worst.min(self.core_angle(sorted_edge(tri[i], tri[(i + 1) % 3])));
             }
         }
         worst
     }
 
-    /// The angle (degrees) on the core's side between the two triangles on `edge`, with the
-    /// nodes at `at`: 180 for an edge with another number of triangles, `None` where a node has
-    /// no position.
-    fn core_angle_at(&self, edge: [u32; 2], at: impl Fn(u32) -> Option<DVec3>) -> Option<f64> {
-        let Some(&[s, t]) = self.on_edge.get(&edge).map(Vec::as_slice) else { return Some(180.0) };
-        let opposite = |t: u32| self.triangles[t as usize].into_iter().find(|n| !edge.contains(n));
-        let (Some(c), Some(d)) = (opposite(s), opposite(t)) else { return Some(180.0) };
-        let [a, b, c, d] = [edge[0], edge[1], c, d].map(&at);
-        let (a, b, c, d) = (a?, b?, c?, d?);
-        let axis = (b - a).normalize_or_zero();
-        let across = |p: DVec3| {
-            let q = p - a;
-            (q - axis * q.dot(axis)).normalize_or_zero()
-        };
-        let angle = across(c).angle_between(across(d)).to_degrees();
-        let [x, y, z] = self.triangles[s as usize].map(&at);
-        let (x, y, z) = (x?, y?, z?);
-        // `d` on the core's side of `s`: the front turns towards the core (a valley).
-        Some(if (y - x).cross(z - x).dot(d - a) > 0.0 { angle } else { 360.0 - angle })
+    /// The angle (degrees) on the core's side between the two triangles on `edge`: 180 plus
+    /// the signed turn there (below 180 in a valley, near 0 at a fold); 180 for an edge with
+    /// another number of triangles.
+    fn core_angle(&self, edge: [u32; 2]) -> f64 {
+        let Some(&[s, t]) = self.on_edge.get(&edge).map(Vec::as_slice) else { return 180.0 };
+        let far = opposite_vertex(self.triangles[t as usize], edge);
+        180.0 + signed_turn_deg(self.corners(s), self.corners(t), self.points[far as usize])
     }
 
     /// Whether triangle `t` is a cap or on a fold.
     fn is_defect(&self, t: u32) -> bool {
         let tri = self.triangles[t as usize];
-        self.is_cap(t) || (0..3).any(|i| self.core_angle(sorted(tri[i], tri[(i + 1) % 3])) < FOLD_ANGLE)
+        self.cap_angle(t) > CAP_ANGLE
+            || (0..3).any(|i| self.core_angle(sorted_edge(tri[i], tri[(i + 1) % 3])) < FOLD_ANGLE)
     }
 
     /// The corners of the quads whose apexes are among `nodes` (a corner's move moves its apex).
@@ -192,14 +172,6 @@ impl CoreFront {
 
     fn defects(&self) -> usize {
         (0..self.triangles.len() as u32).filter(|&t| self.is_defect(t)).count()
-    }
-}
-
-fn sorted(a: u32, b: u32) -> [u32; 2] {
-    if a < b {
-        [a, b]
-    } else {
-        [b, a]
     }
 }
 
@@ -326,11 +298,7 @@ fn best_pull_back(
             continue;
         }
         let valid = cells.iter().all(|(kind, nodes)| {
-            let mut x: CellPoints = [DVec3::ZERO; 8];
-            for (xi, &n) in x.iter_mut().zip(nodes) {
-                *xi = front.points[n as usize];
-            }
-            cell_validity(*kind, &x).is_valid()
+            gather(&front.points, nodes).is_some_and(|x| cell_validity(*kind, &x).is_valid())
         });
         let quality = front.quality_at(v);
         if valid && quality > best.0 {

@@ -26,6 +26,11 @@
 
 use crate::geometry::DVec3;
 
+/// An edge as its two node ids, smaller first: the key of an edge whichever way it is walked.
+pub fn sorted_edge(a: u32, b: u32) -> [u32; 2] {
+    [a.min(b), a.max(b)]
+}
+
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, PartialOrd, Ord, serde::Serialize)]
 #[serde(rename_all = "lowercase")]
 pub enum CellKind {

@@ -10,7 +10,6 @@
 
 use super::topology::{find, opposite_vertex, union, Topology};
 use super::Surface;
-use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
 
 /// The default feature angle: an edge whose normals turn by more than this is a ridge.
@@ -154,25 +153,17 @@ impl Features {
     }
 }
 
-/// Signed turn of edge `e` in degrees. The angle is that between the two triangle normals
-/// (atan2 of their cross and dot products: accurate near 0 and 180); the sign is exact: convex
-/// when the far corner of the second triangle lies behind the plane of the first.
+/// Signed turn of edge `e` in degrees ([`crate::geometry::signed_turn_deg`]): convex when the far
+/// corner of the second triangle lies behind the plane of the first.
 pub fn signed_turn_deg(surface: &Surface, topology: &Topology, e: u32) -> f64 {
     let [first, second] = match topology.edge_uses(e) {
         [a, b] => [a.triangle as usize, b.triangle as usize],
         _ => return 0.0,
     };
-    let (Some([a, b, c]), Some(_)) = (surface_points(surface, first), surface_points(surface, second)) else {
-        return 0.0;
-    };
+    let Some([a, b, c]) = surface_points(surface, first) else { return 0.0 };
+    let Some(second_points) = surface_points(surface, second) else { return 0.0 };
     let far = opposite_vertex(surface.triangles[second], topology.edges[e as usize]);
-    let sign = match orient3d(a, b, c, surface.points[far as usize]) {
-        Sign::Negative => 1.0,
-        Sign::Positive => -1.0,
-        Sign::Zero => return 0.0,
-    };
-    let (n1, n2) = (surface.triangle_area_vector(first), surface.triangle_area_vector(second));
-    sign * n1.cross(n2).length().atan2(n1.dot(n2)).to_degrees()
+    crate::geometry::signed_turn_deg([a, b, c], second_points, surface.points[far as usize])
 }
 
 /// The corner points of triangle `t`, or `None` if it refers to a missing vertex.
