@@ -138,13 +138,16 @@ fn thin_gaps_stop_at_the_medial_surface() {
     assert!(l.full_coverage >= 0.85, "full stacks (or gap-limited) at {:.3} of the wall", l.full_coverage);
 }
 
-/// Fandisk and the flange with issue 7's spec (10 layers from 1e-3 of the diagonal): concave
-/// ridges that meet saddles, thin wall triangles along them, a 1 mm bore. Full stacks within two
-/// thicknesses of a concave ridge: fandisk 99.3%, flange 97.2% (95.9% and 93.7% before a thin
-/// triangle's late corner could merge early, or stop alone, to mend its cell); valid meshes.
+/// Fandisk, the flange and the arrow with issue 7's spec (10 layers from 1e-3 of the diagonal):
+/// concave ridges that meet saddles, thin wall triangles along them, a 1 mm bore, fins on a body
+/// with blunt edges. Full stacks within two thicknesses of a concave ridge: fandisk 99.3%,
+/// flange 98.2%, arrow 88.3% (fandisk 95.9% and flange 93.7% before a thin triangle's late
+/// corner could merge early, or stop alone, to mend its cell; flange 97.3% and arrow 80.1%
+/// before faces left flat along a ridge by the merges were collapsed); valid meshes.
 #[test]
-fn fandisk_and_flange_keep_their_layers_at_the_concave_ridges() {
-    for (name, near_concave, full) in [("fandisk.obj", 0.99, 0.998), ("flange.stl", 0.97, 0.98)] {
+fn fandisk_flange_and_arrow_keep_their_layers_at_the_concave_ridges() {
+    let cases = [("fandisk.obj", 0.99, 0.998), ("flange.stl", 0.98, 0.985), ("arrow_cape.stl", 0.88, 0.96)];
+    for (name, near_concave, full) in cases {
         let out = mesh_shared(name);
         let r = &out.report;
         assert!(r.check.is_valid(), "{name}: {}", r.check);
@@ -195,9 +198,9 @@ fn jittered(surface: &Surface) -> Surface {
 }
 
 /// The 60-degree groove meshed obliquely: every stack should stay full, the top front on the
-/// exact offset. Known to fail (issue 7): 26 columns stop where the groove's walls meet the
+/// exact offset. Known to fail (issue 7): 22 columns stop where the groove's walls meet the
 /// block's ends (y = 0 and 2: fans at the lips' convex edges meeting the groove), 36 without the
-/// corner rule of the entropy collapse.
+/// corner rule of the entropy collapse, 26 without the merge of flat tops.
 #[test]
 #[ignore = "issue 7: columns stop at the ends of an obliquely meshed groove"]
 fn an_obliquely_meshed_groove_keeps_every_layer() {

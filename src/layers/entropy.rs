@@ -292,6 +292,70 @@ pub(super) fn merge_overtaken(
     }
 }
 
+/// A flat top whose longest edge keeps at least this fraction of its bottom's is flat along a
+/// line.
+const LINE_LIKE: f64 = 0.5;
+
+/// Collapse the shortest top edge of every face that the merges left flat or turned over
+/// ([`FLAT_TOP`]) along a line ([`LINE_LIKE`]), with three corners or more still apart, if the
+/// cells around allow it. Where the face columns beside
+/// a ridge merge into its ridge columns, one that goes back along the ridge next to one that goes
+/// forward leaves the face between them flat along the bisector, over three ridge columns
+/// ([`flattened_if_merged`] avoids it only where a choice is left): the other wall's front meets
+/// the ridge's middle column, the flat face does not, and the two cross. Merging the middle ridge
+/// column with one beside it (equal columns meet in the middle, on the bisector of a straight
+/// ridge) gives both sides the same edge there.
+pub(super) fn merge_flat_tops(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    k: u32,
+    invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
+) {
+    for f in 0..front.len() {
+        let Some(face) = plan.merges.resolved_face(front, f) else { continue };
+        let n = face.nodes();
+        // A column that does not move has no proposed top. Above the full stacks (layer `k`
+        // past a full count) a flat face is most often a front closing on itself at a medial
+        // surface, which the crossing guard ends; so is a face that goes flat without the
+        // merges, on a wall strip narrower than twice the layers (collapsing those pinches
+        // the front into a pocket). One turned over without them (a wall edge far shorter
+        // than the layer) is collapsed.
+        let moving = front.face_columns(f).iter().all(|&c| plan.moving[c as usize]);
+        let in_stack = n.iter().all(|&c| columns.full_count(c as usize).is_some_and(|t| k <= t));
+        let flat_by_itself = area_ratio_with(plan, front, f, columns, points, |c| c)
+            .is_some_and(|a| (0.0..FLAT_TOP).contains(&a));
+        let flat = area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP);
+        if n.len() < 3 || !moving || !in_stack || flat_by_itself || !flat {
+            continue;
+        }
+        let top = |c: u32| plan.proposed[c as usize];
+        // Flat along a line, not crushed to a point (the cells' repairs see to those).
+        let bottom = |c: u32| points[columns.node[c as usize] as usize];
+        let longest = |at: &dyn Fn(u32) -> DVec3| {
+            (0..n.len()).map(|i| at(n[i]).distance(at(n[(i + 1) % n.len()]))).fold(0.0, f64::max)
+        };
+        if longest(&top) < LINE_LIKE * longest(&bottom) {
+            continue;
+        }
+        let mut edges: Vec<(f64, u32, u32)> = (0..n.len())
+            .map(|i| (n[i], n[(i + 1) % n.len()]))
+            .filter(|&(a, b)| can_merge(plan, front, columns, a, b))
+            .map(|(a, b)| (top(a).distance_squared(top(b)), a, b))
+            .collect();
+        edges.sort_by(|x, y| x.0.total_cmp(&y.0));
+        for (_, a, b) in edges {
+            let group: Vec<u32> = plan.merges.group(a).chain(plan.merges.group(b)).collect();
+            let before = invalid_cells(plan, &group);
+            if try_collapse(plan, columns, a, b, &|plan, group| invalid_cells(plan, group) <= before) {
+                tracing::debug!(f, a, b, at = ?columns.base[a as usize], "flat top mended by a merge");
+                break;
+            }
+        }
+    }
+}
+
 /// The roots of the columns next to root `c`'s group on the front, other than `c`.
 fn neighbour_roots(plan: &SlabPlan, front: &Front, c: u32) -> Vec<u32> {
     let mut next = Vec::new();

@@ -586,6 +586,7 @@ fn settle_slab(
         }
         entropy::merge_bisector_crossings(&mut plan, front, columns, &mesh.points, walls, invalid_cells);
         entropy::merge_overtaken(&mut plan, front, columns, &mesh.points, walls, k, invalid_cells);
+        entropy::merge_flat_tops(&mut plan, front, columns, &mesh.points, k, invalid_cells);
     }
     let mut to_check: Vec<usize> = (0..front.len()).collect();
     // Two faces that do not move cannot start to cross: only moving ones are suspects.

@@ -119,6 +119,7 @@ pub fn build_layers(
                 vertex_thickness[v] = Some(vertex_thickness[v].map_or(d, |x: f64| x.max(d)));
             }
             if reached < t {
+                tracing::debug!(v, at = ?surface.points[v], reached, full = t, "stack short of its full count");
                 stopped_vertices.push(v as u32);
             }
         }
