@@ -218,7 +218,8 @@ pub fn unfold_front(
             break;
         }
     }
-    stats.undone_moves = undo_crossing_moves(&mut core_front, columns, &tops, &mut moved, surface, layered);
+    stats.undone_moves =
+        undo_crossing_moves(&mut core_front, columns, &tops, &cells, &mut moved, surface, layered);
     for &v in moved.keys() {
         mesh.points[v as usize] = core_front.points[v as usize];
     }
@@ -297,9 +298,7 @@ fn best_pull_back(
         if !front.move_node(v, start - columns.dir[c] * pull) {
             continue;
         }
-        let valid = cells.iter().all(|(kind, nodes)| {
-            gather(&front.points, nodes).is_some_and(|x| cell_validity(*kind, &x).is_valid())
-        });
+        let valid = cells_valid(front, cells);
         let quality = front.quality_at(v);
         if valid && quality > best.0 {
             best = (quality, Some(pull));
@@ -310,13 +309,22 @@ fn best_pull_back(
     best.1
 }
 
+/// Whether every one of `cells` is valid with the front's points.
+fn cells_valid(front: &CoreFront, cells: &[(CellKind, Vec<u32>)]) -> bool {
+    cells.iter().all(|(kind, nodes)| {
+        gather(&front.points, nodes).is_some_and(|x| cell_validity(*kind, &x).is_valid())
+    })
+}
+
 /// Undo the moves of tops whose triangles now cross the core's boundary (the front, its quads'
 /// caps, the walls without layers; exact tests), until none does: the march left a front that
-/// crosses nothing. Returns how many moves were undone.
+/// crosses nothing. A top whose cells turn invalid once a neighbour's move is undone (they were
+/// tested with the neighbour moved) goes back too. Returns how many moves were undone.
 fn undo_crossing_moves(
     front: &mut CoreFront,
     columns: &mut Columns,
     tops: &HashMap<u32, usize>,
+    cells: &HashMap<u32, Vec<(CellKind, Vec<u32>)>>,
     moved: &mut HashMap<u32, (DVec3, f64)>,
     surface: &Surface,
     layered: impl Fn(u32) -> bool,
@@ -345,6 +353,7 @@ fn undo_crossing_moves(
             .flat_map(|tri| tri.into_iter().chain(front.quad_corners_of_apexes(tri)))
             .filter(|v| moved.contains_key(v))
             .collect();
+        undo.extend(moved.keys().copied().filter(|v| !cells_valid(front, &cells[v])));
         undo.sort_unstable();
         undo.dedup();
         if undo.is_empty() {
@@ -385,6 +394,48 @@ mod tests {
         assert!(folded.core_angle([0, 1]) < FOLD_ANGLE);
         assert!(folded.is_defect(0) && folded.is_defect(1));
         assert!(folded.quality_at(3) < FOLD_ANGLE);
+    }
+
+    /// A top whose cell turns invalid goes back even where nothing crosses: a neighbour's move
+    /// that was undone leaves its cells as they were tested with that neighbour moved.
+    #[test]
+    fn an_undo_also_takes_back_a_top_whose_cell_turned_invalid() {
+        use crate::layers::front::ColumnStart;
+        let (below, above) = (DVec3::new(0.5, -0.3, -0.5), DVec3::new(0.5, -0.3, 0.5));
+        let mut front = pair(DVec3::new(0.5, 1.0, 0.0));
+        let tet = vec![(CellKind::Tetrahedron, vec![0, 2, 1, 3])];
+        assert!(front.move_node(3, below));
+        let valid_below = cells_valid(&front, &tet);
+        assert!(front.move_node(3, above));
+        assert!(valid_below != cells_valid(&front, &tet), "one side of the wall triangle is inside out");
+        let (start, moved_to) = if valid_below { (below, above) } else { (above, below) };
+        assert!(front.move_node(3, moved_to));
+        let mut columns = Columns::default();
+        columns.push(ColumnStart {
+            base: DVec3::ZERO,
+            dir: DVec3::Z,
+            scale: 1.0,
+            node: 3,
+            layers: 1,
+            wall_vertex: 0,
+            slide: Slide::Free,
+            spec: None,
+            last_step: 0.5,
+        });
+        let tops = HashMap::from([(3, 0)]);
+        let cells = HashMap::from([(3, tet)]);
+        let mut moved = HashMap::from([(3, (start, 1.0))]);
+        let nothing = Surface {
+            points: Vec::new(),
+            triangles: Vec::new(),
+            triangle_patch: Vec::new(),
+            patch_names: Vec::new(),
+        };
+        let undone =
+            undo_crossing_moves(&mut front, &mut columns, &tops, &cells, &mut moved, &nothing, |_| true);
+        assert_eq!(undone, 1);
+        assert_eq!(front.points[3], start);
+        assert_eq!(columns.last_step[0], 1.0, "its last step is restored");
     }
 
     #[test]
