@@ -5,7 +5,8 @@
 //!
 //! A column that stopped early is gap-limited when the ray along its direction from its wall
 //! point meets the wall again, facing it (the two normals within [`FACING_ANGLE_DEG`] of
-//! opposite), and its top, with the layer it could not build, reaches half way across. The
+//! opposite), and its top, with the layer it could not build, reaches half way across (with
+//! the two layers it could not build where the front closes on an axis, as in a bore). The
 //! fronts at a concave ridge do not face each other this way (the rays run along the other
 //! wall), so a stop there is never excused.
 
@@ -73,12 +74,35 @@ fn reaches_medial_surface(
     let carrier = columns.carrier(c);
     let k = columns.layers[carrier];
     let rise = (points[columns.node[carrier] as usize] - base).dot(dir);
-    // The layer it could not build (or, past its stack, its last one).
-    let next = match columns.layer_height(carrier, k + 1) {
+    // The layers it could not build (or, past its stack, its last one).
+    let height = |j: u32| match columns.layer_height(carrier, j) {
         h if h > 0.0 => h,
         _ => columns.layer_height(carrier, k.max(1)),
     };
-    rise + columns.scale[carrier] * next >= 0.5 * across
+    let next = height(k + 1);
+    // A front closing on an axis (a bore narrower than twice the stack) shrinks around it as
+    // it rises: the last layer short of the axis would be crushed along the front to a small
+    // fraction of its width and cannot be built (the flange's 1 mm bore: six layers reach 75%
+    // of its radius, a seventh would reach 97%). Where the wall across faces back and the
+    // front closes, two layers short of the medial surface is as far as it goes.
+    let reach = if closes_on_an_axis(surface, bvh, base, dir, across) { next + height(k + 2) } else { next };
+    rise + columns.scale[carrier] * reach >= 0.5 * across
+}
+
+/// Tilt (degrees) of the rays that probe whether the wall across curves around a column.
+const PROBE_TILT_DEG: f64 = 20.0;
+
+/// Whether the wall across a gap (`across` along `dir` from `base`) curves around the ray in
+/// one direction, as in a bore: rays tilted both ways in that direction hit it sooner than the
+/// straight one (a chord of the bore), where across a flat gap they would hit it later.
+fn closes_on_an_axis(surface: &Surface, bvh: &TriangleBvh, base: DVec3, dir: DVec3, across: f64) -> bool {
+    let (sin, cos) = PROBE_TILT_DEG.to_radians().sin_cos();
+    let u = dir.any_orthonormal_vector();
+    let hit = |side: DVec3| bvh.first_hit(base, cos * dir + sin * side, OWN_WALL * across, |_| false);
+    let sooner = |side: DVec3| {
+        hit(side).is_some_and(|(t, tri)| t < across && surface.triangle_normal(tri as usize).dot(dir) < 0.0)
+    };
+    [u, dir.cross(u)].into_iter().any(|side| sooner(side) && sooner(-side))
 }
 
 #[cfg(test)]
@@ -127,6 +151,56 @@ mod tests {
         let mut points = surface.points.clone();
         points.push(DVec3::new(0.0, 0.0, top));
         gap_limited(&surface, &columns, &points, &[0])[0]
+    }
+
+    /// The inside of a tube of radius 1 along z (`n` sides, rings at z = -1, 0, 1), its
+    /// triangles facing the axis.
+    fn bore(n: usize) -> Surface {
+        let mut points = Vec::new();
+        for z in [-1.0, 0.0, 1.0] {
+            for i in 0..n {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                points.push(DVec3::new(a.cos(), a.sin(), z));
+            }
+        }
+        let at = |ring: usize, i: usize| (ring * n + i % n) as u32;
+        let mut triangles = Vec::new();
+        for ring in 0..2 {
+            for i in 0..n {
+                triangles.push([at(ring, i), at(ring + 1, i), at(ring, i + 1)]);
+                triangles.push([at(ring, i + 1), at(ring + 1, i), at(ring + 1, i + 1)]);
+            }
+        }
+        let count = triangles.len();
+        Surface { points, triangles, triangle_patch: vec![0; count], patch_names: vec!["bore".into()] }
+    }
+
+    #[test]
+    fn a_bore_closes_on_its_axis_and_a_flat_gap_does_not() {
+        let tube = bore(24);
+        let bvh = TriangleBvh::new((0..tube.triangles.len()).map(|t| tube.triangle_points(t)).collect());
+        let (base, dir) = (DVec3::X, -DVec3::X);
+        assert!(tube.triangle_normal(0).dot(DVec3::new(-1.0, -0.1, 0.0)) > 0.9, "facing the axis");
+        let (across, _) = bvh.first_hit(base, dir, 1e-6, |_| false).unwrap();
+        assert!((across - 2.0).abs() < 1e-9);
+        assert!(closes_on_an_axis(&tube, &bvh, base, dir, across));
+        // Two parallel walls 2 apart: tilted rays hit the far one later.
+        let flat = Surface {
+            points: vec![
+                DVec3::new(0.0, -5.0, -5.0),
+                DVec3::new(0.0, 5.0, -5.0),
+                DVec3::new(0.0, 0.0, 5.0),
+                DVec3::new(-2.0, -5.0, -5.0),
+                DVec3::new(-2.0, 0.0, 5.0),
+                DVec3::new(-2.0, 5.0, -5.0),
+            ],
+            triangles: vec![[0, 2, 1], [3, 5, 4]],
+            triangle_patch: vec![0, 0],
+            patch_names: vec!["wall".into()],
+        };
+        let bvh = TriangleBvh::new((0..2).map(|t| flat.triangle_points(t)).collect());
+        assert!(flat.triangle_normal(1).dot(dir) < -0.99, "the far wall faces back");
+        assert!(!closes_on_an_axis(&flat, &bvh, DVec3::ZERO, dir, 2.0));
     }
 
     #[test]
