@@ -298,13 +298,13 @@ const LINE_LIKE: f64 = 0.5;
 
 /// Collapse the shortest top edge of every face that the merges left flat or turned over
 /// ([`FLAT_TOP`]) along a line ([`LINE_LIKE`]), with three corners or more still apart, if the
-/// cells around allow it. Where the face columns beside
-/// a ridge merge into its ridge columns, one that goes back along the ridge next to one that goes
-/// forward leaves the face between them flat along the bisector, over three ridge columns
-/// ([`flattened_if_merged`] avoids it only where a choice is left): the other wall's front meets
-/// the ridge's middle column, the flat face does not, and the two cross. Merging the middle ridge
-/// column with one beside it (equal columns meet in the middle, on the bisector of a straight
-/// ridge) gives both sides the same edge there.
+/// cells around allow it. Where the face columns beside a ridge merge into its ridge columns,
+/// one that goes back along the ridge next to one that goes forward leaves the face between
+/// them flat along the bisector, over three ridge columns ([`flattened_if_merged`] avoids it
+/// only where a choice is left): the other wall's front meets the ridge's middle column, the
+/// flat face does not, and the two cross. Merging the middle ridge column with one beside it
+/// (equal columns meet in the middle, on the bisector of a straight ridge) gives both sides the
+/// same edge there.
 pub(super) fn merge_flat_tops(
     plan: &mut SlabPlan,
     front: &Front,
@@ -324,10 +324,13 @@ pub(super) fn merge_flat_tops(
         // than the layer) is collapsed.
         let moving = front.face_columns(f).iter().all(|&c| plan.moving[c as usize]);
         let in_stack = n.iter().all(|&c| columns.full_count(c as usize).is_some_and(|t| k <= t));
+        if n.len() < 3 || !moving || !in_stack {
+            continue;
+        }
+        let flat = area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP);
         let flat_by_itself = area_ratio_with(plan, front, f, columns, points, |c| c)
             .is_some_and(|a| (0.0..FLAT_TOP).contains(&a));
-        let flat = area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP);
-        if n.len() < 3 || !moving || !in_stack || flat_by_itself || !flat {
+        if !flat || flat_by_itself {
             continue;
         }
         let top = |c: u32| plan.proposed[c as usize];
@@ -930,6 +933,64 @@ mod tests {
         assert_eq!(flattened_if_merged(&plan, &front, &columns, &bottoms, 2, 4), 1);
         // Into 1: it keeps two corners and vanishes, and so does (1, 2, 4): nothing left flat.
         assert_eq!(flattened_if_merged(&plan, &front, &columns, &bottoms, 1, 4), 0);
+    }
+
+    /// A ridge along x (columns 0-4 at y = 0) between two walls of face columns (5-8 at y = 1,
+    /// 9-12 at y = -1), every column rising by 0.1; face columns 6 and 7 beside ridge column 2
+    /// merge into ridge columns 1 and 3, leaving the face (2, 7, 6) flat on the ridge.
+    #[test]
+    fn a_face_flattened_along_a_ridge_by_merges_both_ways_is_collapsed() {
+        use crate::config::{LayerCount, LayerSettings, LayerSpec};
+        let settings = LayerSettings {
+            first_height: Some(0.01),
+            growth: Some(1.2),
+            count: Some(LayerCount::Fixed(10)),
+            thickness: None,
+            transition: Some(false),
+        };
+        let spec = LayerSpec::resolve(&settings, 1.0).unwrap();
+        let ridge = (0..5).map(|i| DVec3::new(i as f64, 0.0, 0.0));
+        let side = |y: f64| (0..4).map(move |i| DVec3::new(i as f64 + 0.5, y, 0.0));
+        let bottoms: Vec<DVec3> = ridge.chain(side(1.0)).chain(side(-1.0)).collect();
+        let mut columns = Columns::default();
+        for (c, &base) in bottoms.iter().enumerate() {
+            columns.push(ColumnStart {
+                base,
+                dir: DVec3::Z,
+                scale: 1.0,
+                node: c as u32,
+                layers: 0,
+                wall_vertex: c as u32,
+                slide: Default::default(),
+                spec: Some(spec),
+                last_step: 0.0,
+            });
+        }
+        let mut front = Front::default();
+        for i in 0..4u32 {
+            let (r, a, b) = (i, 5 + i, 9 + i);
+            front.push(&[r, r + 1, a], 0, None);
+            front.push(&[r + 1, b, r], 0, None);
+            if i < 3 {
+                front.push(&[r + 1, a + 1, a], 0, None);
+                front.push(&[r + 1, b, b + 1], 0, None);
+            }
+        }
+        front.index_columns(bottoms.len());
+        let mut plan = plan_of(bottoms.iter().map(|&b| b + 0.1 * DVec3::Z).collect());
+        plan.merges.merge(1, 6);
+        plan.merges.merge(3, 7);
+        let flat = |plan: &SlabPlan| {
+            (0..front.len())
+                .filter(|&f| plan.merges.face_roots(&front, f).len() >= 3)
+                .any(|f| area_ratio(plan, &front, f, &columns, &bottoms).is_some_and(|a| a < FLAT_TOP))
+        };
+        assert!(flat(&plan), "the face between the two merges lies flat on the ridge");
+        merge_flat_tops(&mut plan, &front, &columns, &bottoms, 1, |_, _| 0);
+        assert!(!flat(&plan));
+        let root = |c: u32| plan.merges.root(c);
+        assert!(root(2) == root(1) || root(2) == root(3), "the middle ridge column merged");
+        assert_eq!(plan.proposed[root(2) as usize].y, 0.0, "on the ridge's bisector");
     }
 
     /// A corner overtaking its opposite edge while no edge of the triangle shrinks much.

@@ -85,20 +85,27 @@ fn reaches_medial_surface(
     // fraction of its width and cannot be built (the flange's 1 mm bore: six layers reach 75%
     // of its radius, a seventh would reach 97%). Where the wall across faces back and the
     // front closes, two layers short of the medial surface is as far as it goes.
-    let reach = if closes_on_an_axis(surface, bvh, base, dir, across) { next + height(k + 2) } else { next };
+    let closes = closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across);
+    let reach = if closes { next + height(k + 2) } else { next };
     rise + columns.scale[carrier] * reach >= 0.5 * across
 }
 
 /// Tilt (degrees) of the rays that probe whether the wall across curves around a column.
 const PROBE_TILT_DEG: f64 = 20.0;
 
-/// Whether the wall across a gap (`across` along `dir` from `base`) curves around the ray in
-/// one direction, as in a bore: rays tilted both ways in that direction hit it sooner than the
-/// straight one (a chord of the bore), where across a flat gap they would hit it later.
-fn closes_on_an_axis(surface: &Surface, bvh: &TriangleBvh, base: DVec3, dir: DVec3, across: f64) -> bool {
+/// Whether the wall across a gap (`across` along `dir` from `base`, hits nearer than `skip`
+/// being the column's own wall) curves around the ray in one direction, as in a bore: rays
+/// tilted both ways in that direction hit it sooner than the straight one (a chord of the
+/// bore), where across a flat gap they would hit it later.
+fn closes_on_an_axis(
+    surface: &Surface,
+    bvh: &TriangleBvh,
+    (base, dir, skip): (DVec3, DVec3, f64),
+    across: f64,
+) -> bool {
     let (sin, cos) = PROBE_TILT_DEG.to_radians().sin_cos();
     let u = dir.any_orthonormal_vector();
-    let hit = |side: DVec3| bvh.first_hit(base, cos * dir + sin * side, OWN_WALL * across, |_| false);
+    let hit = |side: DVec3| bvh.first_hit(base, cos * dir + sin * side, skip, |_| false);
     let sooner = |side: DVec3| {
         hit(side).is_some_and(|(t, tri)| t < across && surface.triangle_normal(tri as usize).dot(dir) < 0.0)
     };
@@ -183,7 +190,7 @@ mod tests {
         assert!(tube.triangle_normal(0).dot(DVec3::new(-1.0, -0.1, 0.0)) > 0.9, "facing the axis");
         let (across, _) = bvh.first_hit(base, dir, 1e-6, |_| false).unwrap();
         assert!((across - 2.0).abs() < 1e-9);
-        assert!(closes_on_an_axis(&tube, &bvh, base, dir, across));
+        assert!(closes_on_an_axis(&tube, &bvh, (base, dir, 1e-6), across));
         // Two parallel walls 2 apart: tilted rays hit the far one later.
         let flat = Surface {
             points: vec![
@@ -200,7 +207,7 @@ mod tests {
         };
         let bvh = TriangleBvh::new((0..2).map(|t| flat.triangle_points(t)).collect());
         assert!(flat.triangle_normal(1).dot(dir) < -0.99, "the far wall faces back");
-        assert!(!closes_on_an_axis(&flat, &bvh, DVec3::ZERO, dir, 2.0));
+        assert!(!closes_on_an_axis(&flat, &bvh, (DVec3::ZERO, dir, 1e-6), 2.0));
     }
 
     #[test]
