@@ -396,6 +396,21 @@ pub struct LayerSpec {
     max_count: u32,
 }
 
+#[cfg(test)]
+impl LayerSpec {
+    /// `count` layers from `first_height` growing by `growth`, no transition layers (for tests).
+    pub(crate) fn fixed(first_height: f64, growth: f64, count: u32) -> LayerSpec {
+        let settings = LayerSettings {
+            first_height: Some(first_height),
+            growth: Some(growth),
+            count: Some(LayerCount::Fixed(count)),
+            thickness: None,
+            transition: Some(false),
+        };
+        LayerSpec::resolve(&settings, 1.0).expect("valid test settings")
+    }
+}
+
 impl LayerSpec {
     /// Resolve user settings against the body size (bounding-box diagonal).
     pub fn resolve(s: &LayerSettings, body_size: f64) -> Result<LayerSpec, ConfigError> {

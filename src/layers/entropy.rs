@@ -860,14 +860,7 @@ mod tests {
     /// Lateness (in layer heights) of a column from `bottom` to `top` at its layer `k` of
     /// uniform 0.1-high layers, over [`two_walls`] extended far out.
     fn lateness_case(bottom: DVec3, top: DVec3, k: u32) -> f64 {
-        let settings = crate::config::LayerSettings {
-            first_height: Some(0.1),
-            growth: Some(1.0),
-            count: Some(crate::config::LayerCount::Fixed(20)),
-            thickness: None,
-            transition: Some(false),
-        };
-        let spec = crate::config::LayerSpec::resolve(&settings, 1.0).unwrap();
+        let spec = crate::config::LayerSpec::fixed(0.1, 1.0, 20);
         let mut columns = Columns::default();
         columns.push(ColumnStart {
             base: bottom,
@@ -940,15 +933,7 @@ mod tests {
     /// merge into ridge columns 1 and 3, leaving the face (2, 7, 6) flat on the ridge.
     #[test]
     fn a_face_flattened_along_a_ridge_by_merges_both_ways_is_collapsed() {
-        use crate::config::{LayerCount, LayerSettings, LayerSpec};
-        let settings = LayerSettings {
-            first_height: Some(0.01),
-            growth: Some(1.2),
-            count: Some(LayerCount::Fixed(10)),
-            thickness: None,
-            transition: Some(false),
-        };
-        let spec = LayerSpec::resolve(&settings, 1.0).unwrap();
+        let spec = crate::config::LayerSpec::fixed(0.01, 1.2, 10);
         let ridge = (0..5).map(|i| DVec3::new(i as f64, 0.0, 0.0));
         let side = |y: f64| (0..4).map(move |i| DVec3::new(i as f64 + 0.5, y, 0.0));
         let bottoms: Vec<DVec3> = ridge.chain(side(1.0)).chain(side(-1.0)).collect();

@@ -115,7 +115,7 @@ fn closes_on_an_axis(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::config::{LayerCount, LayerSettings, LayerSpec};
+    use crate::config::LayerSpec;
     use crate::layers::front::ColumnStart;
     use crate::normals::constraint::Slide;
 
@@ -135,14 +135,7 @@ mod tests {
             patch_names: vec!["wall".into()],
         };
         assert!(surface.triangle_normal(1).dot(n) > 0.999);
-        let settings = LayerSettings {
-            first_height: Some(0.01),
-            growth: Some(1.2),
-            count: Some(LayerCount::Fixed(10)),
-            thickness: None,
-            transition: Some(false),
-        };
-        let spec = LayerSpec::resolve(&settings, 1.0).unwrap();
+        let spec = LayerSpec::fixed(0.01, 1.2, 10);
         let mut columns = Columns::default();
         columns.push(ColumnStart {
             base: DVec3::ZERO,
