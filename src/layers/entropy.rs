@@ -296,15 +296,16 @@ pub(super) fn merge_overtaken(
 /// line.
 const LINE_LIKE: f64 = 0.5;
 
-/// Collapse the shortest top edge of every face that the merges left flat or turned over
-/// ([`FLAT_TOP`]) along a line ([`LINE_LIKE`]), with three corners or more still apart, if the
-/// cells around allow it. Where the face columns beside a ridge merge into its ridge columns,
-/// one that goes back along the ridge next to one that goes forward leaves the face between
-/// them flat along the bisector, over three ridge columns ([`flattened_if_merged`] avoids it
-/// only where a choice is left): the other wall's front meets the ridge's middle column, the
-/// flat face does not, and the two cross. Merging the middle ridge column with one beside it
-/// (equal columns meet in the middle, on the bisector of a straight ridge) gives both sides the
-/// same edge there.
+/// Collapse the shortest top edge of every face left flat or turned over ([`FLAT_TOP`]) along
+/// a line ([`LINE_LIKE`]), with three corners or more still apart, if the cells around allow
+/// it. The merges make such faces: where the face columns beside a ridge merge into its ridge
+/// columns, one that goes back along the ridge next to one that goes forward leaves the face
+/// between them flat along the bisector, over three ridge columns ([`flattened_if_merged`]
+/// avoids it only where a choice is left); the other wall's front meets the ridge's middle
+/// column, the flat face does not, and the two cross. Merging the middle ridge column with one
+/// beside it (equal columns meet in the middle, on the bisector of a straight ridge) gives both
+/// sides the same edge there. So do a wall edge far shorter than the layer (its face turns
+/// over in one layer) and a valley narrower than the layers (its faces squeezed flat).
 pub(super) fn merge_flat_tops(
     plan: &mut SlabPlan,
     front: &Front,
@@ -318,19 +319,14 @@ pub(super) fn merge_flat_tops(
         let n = face.nodes();
         // A column that does not move has no proposed top. Above the full stacks (layer `k`
         // past a full count) a flat face is most often a front closing on itself at a medial
-        // surface, which the crossing guard ends; so is a face that goes flat without the
-        // merges, on a wall strip narrower than twice the layers (collapsing those pinches
-        // the front into a pocket). One turned over without them (a wall edge far shorter
-        // than the layer) is collapsed.
+        // surface (a wall strip narrower than twice the layers), which the crossing guard
+        // ends: collapsing those pinched an internal box's front into a pocket.
         let moving = front.face_columns(f).iter().all(|&c| plan.moving[c as usize]);
         let in_stack = n.iter().all(|&c| columns.full_count(c as usize).is_some_and(|t| k <= t));
         if n.len() < 3 || !moving || !in_stack {
             continue;
         }
-        let flat = area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP);
-        let flat_by_itself = area_ratio_with(plan, front, f, columns, points, |c| c)
-            .is_some_and(|a| (0.0..FLAT_TOP).contains(&a));
-        if !flat || flat_by_itself {
+        if !area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP) {
             continue;
         }
         let top = |c: u32| plan.proposed[c as usize];
