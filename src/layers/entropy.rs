@@ -306,6 +306,7 @@ const LINE_LIKE: f64 = 0.5;
 /// beside it (equal columns meet in the middle, on the bisector of a straight ridge) gives both
 /// sides the same edge there. So do a wall edge far shorter than the layer (its face turns
 /// over in one layer) and a valley narrower than the layers (its faces squeezed flat).
+/// Returns the number of collapses.
 pub(super) fn merge_flat_tops(
     plan: &mut SlabPlan,
     front: &Front,
@@ -313,7 +314,8 @@ pub(super) fn merge_flat_tops(
     points: &[DVec3],
     k: u32,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
-) {
+) -> usize {
+    let mut merged = 0;
     for f in 0..front.len() {
         let Some(face) = plan.merges.resolved_face(front, f) else { continue };
         let n = face.nodes();
@@ -349,10 +351,12 @@ pub(super) fn merge_flat_tops(
             let before = invalid_cells(plan, &group);
             if try_collapse(plan, columns, a, b, &|plan, group| invalid_cells(plan, group) <= before) {
                 tracing::debug!(f, a, b, at = ?columns.base[a as usize], "flat top mended by a merge");
+                merged += 1;
                 break;
             }
         }
     }
+    merged
 }
 
 /// The roots of the columns next to root `c`'s group on the front, other than `c`.
@@ -791,6 +795,7 @@ mod tests {
             redirected: Vec::new(),
             collapses: 0,
             coarsened: 0,
+            flat_tops: 0,
         }
     }
 
@@ -967,7 +972,7 @@ mod tests {
                 .any(|f| area_ratio(plan, &front, f, &columns, &bottoms).is_some_and(|a| a < FLAT_TOP))
         };
         assert!(flat(&plan), "the face between the two merges lies flat on the ridge");
-        merge_flat_tops(&mut plan, &front, &columns, &bottoms, 1, |_, _| 0);
+        assert_eq!(merge_flat_tops(&mut plan, &front, &columns, &bottoms, 1, |_, _| 0), 1);
         assert!(!flat(&plan));
         let root = |c: u32| plan.merges.root(c);
         assert!(root(2) == root(1) || root(2) == root(3), "the middle ridge column merged");

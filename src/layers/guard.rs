@@ -448,6 +448,7 @@ mod tests {
                 redirected: Vec::new(),
                 collapses: 0,
                 coarsened: 0,
+                flat_tops: 0,
             };
             if guard.is_stale(k, &plan) {
                 let end: Vec<DVec3> = (0..6)

@@ -44,6 +44,8 @@ pub struct MarchStats {
     pub splits: usize,
     /// Short front edges collapsed to the tangential size (two columns merged into one).
     pub tangential_collapses: usize,
+    /// Of the collapses where fronts met, those of faces left flat along a line.
+    pub flat_top_collapses: usize,
     /// Long front edges left unsplit for a layer because the split would have made an invalid
     /// cell.
     pub splits_given_up: usize,
@@ -140,6 +142,8 @@ pub(super) struct SlabPlan {
     pub collapses: usize,
     /// Of those, the tangential collapses of short edges ([`super::coarsen`]).
     pub coarsened: usize,
+    /// Of those, the collapses of faces left flat along a line ([`entropy::merge_flat_tops`]).
+    pub flat_tops: usize,
 }
 
 impl SlabPlan {
@@ -392,6 +396,7 @@ pub fn march(
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses - plan.coarsened;
         stats.tangential_collapses += plan.coarsened;
+        stats.flat_top_collapses += plan.flat_tops;
         let (split_count, swap_count) =
             commit_slab(mesh, columns, front, &plan, &reshape, sizes, k, &mut stats);
         stats.splits += split_count;
@@ -572,6 +577,7 @@ fn settle_slab(
         redirected: Vec::new(),
         collapses: 0,
         coarsened: 0,
+        flat_tops: 0,
     };
     {
         let invalid_cells =
@@ -586,7 +592,7 @@ fn settle_slab(
         }
         entropy::merge_bisector_crossings(&mut plan, front, columns, &mesh.points, walls, invalid_cells);
         entropy::merge_overtaken(&mut plan, front, columns, &mesh.points, walls, k, invalid_cells);
-        entropy::merge_flat_tops(&mut plan, front, columns, &mesh.points, k, invalid_cells);
+        plan.flat_tops = entropy::merge_flat_tops(&mut plan, front, columns, &mesh.points, k, invalid_cells);
     }
     let mut to_check: Vec<usize> = (0..front.len()).collect();
     // Two faces that do not move cannot start to cross: only moving ones are suspects.
