@@ -149,7 +149,7 @@ fn thin_gaps_stop_at_the_medial_surface() {
 /// meshes.
 #[test]
 fn fandisk_flange_and_arrow_keep_their_layers_at_the_concave_ridges() {
-    let cases = [("fandisk.obj", 0.99, 0.998), ("flange.stl", 0.98, 0.985), ("arrow_cape.stl", 0.88, 0.96)];
+    let cases = [("fandisk.obj", 0.99, 0.998), ("flange.stl", 0.98, 0.985), ("arrow_cape.stl", 0.87, 0.955)];
     for (name, near_concave, full) in cases {
         let out = mesh_shared(name);
         let r = &out.report;
