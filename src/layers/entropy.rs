@@ -894,13 +894,8 @@ mod tests {
         assert_eq!(lateness_case(chord(0.2), chord(0.3), 3), 0.0);
     }
 
-    /// Ridge columns 0, 1, 2 along x at y = 0 and face columns 3 (x = 0.5) and 4 (x = 1.5) at
-    /// y = 1, in triangles (0, 1, 3), (3, 1, 4), (1, 2, 4); every top 0.1 up the ridge's
-    /// bisector, so the ridge columns' tops lie on a line. Column 3 has merged into 0.
-    #[test]
-    fn a_merge_that_would_fold_the_front_along_a_ridge_is_seen() {
-        let bottoms =
-            [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (0.5, 1.0), (1.5, 1.0)].map(|(x, y)| DVec3::new(x, y, 0.0));
+    /// A column up +z from each of `bottoms` (column, node and wall vertex `c` at `bottoms[c]`).
+    fn rising_columns(bottoms: &[DVec3], spec: Option<crate::config::LayerSpec>) -> Columns {
         let mut columns = Columns::default();
         for (c, &base) in bottoms.iter().enumerate() {
             columns.push(ColumnStart {
@@ -911,10 +906,21 @@ mod tests {
                 layers: 0,
                 wall_vertex: c as u32,
                 slide: Default::default(),
-                spec: None,
+                spec,
                 last_step: 0.0,
             });
         }
+        columns
+    }
+
+    /// Ridge columns 0, 1, 2 along x at y = 0 and face columns 3 (x = 0.5) and 4 (x = 1.5) at
+    /// y = 1, in triangles (0, 1, 3), (3, 1, 4), (1, 2, 4); every top 0.1 up the ridge's
+    /// bisector, so the ridge columns' tops lie on a line. Column 3 has merged into 0.
+    #[test]
+    fn a_merge_that_would_fold_the_front_along_a_ridge_is_seen() {
+        let bottoms =
+            [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (0.5, 1.0), (1.5, 1.0)].map(|(x, y)| DVec3::new(x, y, 0.0));
+        let columns = rising_columns(&bottoms, None);
         let mut front = Front::default();
         for t in [[0, 1, 3], [3, 1, 4], [1, 2, 4]] {
             front.push(&t, 0, None);
@@ -938,20 +944,7 @@ mod tests {
         let ridge = (0..5).map(|i| DVec3::new(i as f64, 0.0, 0.0));
         let side = |y: f64| (0..4).map(move |i| DVec3::new(i as f64 + 0.5, y, 0.0));
         let bottoms: Vec<DVec3> = ridge.chain(side(1.0)).chain(side(-1.0)).collect();
-        let mut columns = Columns::default();
-        for (c, &base) in bottoms.iter().enumerate() {
-            columns.push(ColumnStart {
-                base,
-                dir: DVec3::Z,
-                scale: 1.0,
-                node: c as u32,
-                layers: 0,
-                wall_vertex: c as u32,
-                slide: Default::default(),
-                spec: Some(spec),
-                last_step: 0.0,
-            });
-        }
+        let columns = rising_columns(&bottoms, Some(spec));
         let mut front = Front::default();
         for i in 0..4u32 {
             let (r, a, b) = (i, 5 + i, 9 + i);
