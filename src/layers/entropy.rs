@@ -360,7 +360,7 @@ pub(super) fn merge_flat_tops(
 }
 
 /// The roots of the columns next to root `c`'s group on the front, other than `c`.
-fn neighbour_roots(plan: &SlabPlan, front: &Front, c: u32) -> Vec<u32> {
+pub(super) fn neighbour_roots(plan: &SlabPlan, front: &Front, c: u32) -> Vec<u32> {
     let mut next = Vec::new();
     for g in plan.merges.group(c) {
         front.neighbours(g as usize, &mut next);
@@ -786,19 +786,6 @@ mod tests {
     use super::*;
     use crate::layers::front::ColumnStart;
 
-    /// A slab plan moving every column to its `proposed` top, nothing merged yet.
-    fn plan_of(proposed: Vec<DVec3>) -> SlabPlan {
-        SlabPlan {
-            moving: vec![true; proposed.len()],
-            merges: super::super::collapse::Merges::new(proposed.len()),
-            proposed,
-            redirected: Vec::new(),
-            collapses: 0,
-            coarsened: 0,
-            flat_tops: 0,
-        }
-    }
-
     /// The ridge vertex 0 at the origin with one triangle `size` long on each wall: wall 1
     /// (y = 0, x > 0, normal +y) and wall 2 (x = 0, y > 0, normal +x).
     fn two_walls(size: f64) -> Surface {
@@ -835,7 +822,7 @@ mod tests {
                 last_step: 0.0,
             });
         }
-        let plan = plan_of(vec![bisector * 2f64.sqrt() * d, at + dir * d]);
+        let plan = SlabPlan::moving_to(vec![bisector * 2f64.sqrt() * d, at + dir * d]);
         let surface = two_walls(1.0);
         assert_eq!((surface.triangle_normal(0), surface.triangle_normal(1)), (DVec3::Y, DVec3::X));
         let topology = Topology::new(&surface);
@@ -874,7 +861,7 @@ mod tests {
             spec: Some(spec),
             last_step: 0.1,
         });
-        let plan = plan_of(vec![top]);
+        let plan = SlabPlan::moving_to(vec![top]);
         let surface = two_walls(10.0);
         let topology = Topology::new(&surface);
         let walls = VertexWalls::new(&surface, &topology, |_| true);
@@ -894,25 +881,6 @@ mod tests {
         assert_eq!(lateness_case(chord(0.2), chord(0.3), 3), 0.0);
     }
 
-    /// A column up +z from each of `bottoms` (column, node and wall vertex `c` at `bottoms[c]`).
-    fn rising_columns(bottoms: &[DVec3], spec: Option<crate::config::LayerSpec>) -> Columns {
-        let mut columns = Columns::default();
-        for (c, &base) in bottoms.iter().enumerate() {
-            columns.push(ColumnStart {
-                base,
-                dir: DVec3::Z,
-                scale: 1.0,
-                node: c as u32,
-                layers: 0,
-                wall_vertex: c as u32,
-                slide: Default::default(),
-                spec,
-                last_step: 0.0,
-            });
-        }
-        columns
-    }
-
     /// Ridge columns 0, 1, 2 along x at y = 0 and face columns 3 (x = 0.5) and 4 (x = 1.5) at
     /// y = 1, in triangles (0, 1, 3), (3, 1, 4), (1, 2, 4); every top 0.1 up the ridge's
     /// bisector, so the ridge columns' tops lie on a line. Column 3 has merged into 0.
@@ -920,14 +888,14 @@ mod tests {
     fn a_merge_that_would_fold_the_front_along_a_ridge_is_seen() {
         let bottoms =
             [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (0.5, 1.0), (1.5, 1.0)].map(|(x, y)| DVec3::new(x, y, 0.0));
-        let columns = rising_columns(&bottoms, None);
+        let columns = Columns::rising(&bottoms, None);
         let mut front = Front::default();
         for t in [[0, 1, 3], [3, 1, 4], [1, 2, 4]] {
             front.push(&t, 0, None);
         }
         front.index_columns(5);
         let up = DVec3::new(0.0, 0.1, 0.1);
-        let mut plan = plan_of(bottoms.iter().map(|&b| DVec3::new(b.x, 0.0, 0.0) + up).collect());
+        let mut plan = SlabPlan::moving_to(bottoms.iter().map(|&b| DVec3::new(b.x, 0.0, 0.0) + up).collect());
         plan.merges.merge(0, 3);
         // Into 2: triangle (3, 1, 4) becomes (0, 1, 2), three tops on a line.
         assert_eq!(flattened_if_merged(&plan, &front, &columns, &bottoms, 2, 4), 1);
@@ -944,7 +912,7 @@ mod tests {
         let ridge = (0..5).map(|i| DVec3::new(i as f64, 0.0, 0.0));
         let side = |y: f64| (0..4).map(move |i| DVec3::new(i as f64 + 0.5, y, 0.0));
         let bottoms: Vec<DVec3> = ridge.chain(side(1.0)).chain(side(-1.0)).collect();
-        let columns = rising_columns(&bottoms, Some(spec));
+        let columns = Columns::rising(&bottoms, Some(spec));
         let mut front = Front::default();
         for i in 0..4u32 {
             let (r, a, b) = (i, 5 + i, 9 + i);
@@ -956,7 +924,7 @@ mod tests {
             }
         }
         front.index_columns(bottoms.len());
-        let mut plan = plan_of(bottoms.iter().map(|&b| b + 0.1 * DVec3::Z).collect());
+        let mut plan = SlabPlan::moving_to(bottoms.iter().map(|&b| b + 0.1 * DVec3::Z).collect());
         plan.merges.merge(1, 6);
         plan.merges.merge(3, 7);
         let flat = |plan: &SlabPlan| {

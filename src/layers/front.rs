@@ -64,6 +64,28 @@ pub struct ColumnStart {
 /// `Columns::merged_into` of a column that has not merged.
 pub const NOT_MERGED: u32 = u32::MAX;
 
+#[cfg(test)]
+impl Columns {
+    /// A column up +z from each of `bottoms` (column, node and wall vertex `c` at `bottoms[c]`).
+    pub(crate) fn rising(bottoms: &[DVec3], spec: Option<LayerSpec>) -> Columns {
+        let mut columns = Columns::default();
+        for (c, &base) in bottoms.iter().enumerate() {
+            columns.push(ColumnStart {
+                base,
+                dir: DVec3::Z,
+                scale: 1.0,
+                node: c as u32,
+                layers: 0,
+                wall_vertex: c as u32,
+                slide: Default::default(),
+                spec,
+                last_step: 0.0,
+            });
+        }
+        columns
+    }
+}
+
 impl Columns {
     pub fn len(&self) -> usize {
         self.base.len()

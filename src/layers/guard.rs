@@ -410,7 +410,6 @@ pub fn pyramid_apex(x: [DVec3; 4]) -> Option<DVec3> {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layers::collapse::Merges;
 
     /// Two triangles marching towards each other: a floor rising from z = 0 and a tilted triangle
     /// sinking from z = 0.6, 0.1 per layer each. Their tops first touch at layer 3 (floor at
@@ -441,15 +440,7 @@ mod tests {
         for k in 1..=3u32 {
             let proposed: Vec<DVec3> =
                 (0..6).map(|c| mesh.points[columns.node[c] as usize] + columns.dir[c] * 0.1).collect();
-            let plan = SlabPlan {
-                moving: vec![true; 6],
-                proposed: proposed.clone(),
-                merges: Merges::new(6),
-                redirected: Vec::new(),
-                collapses: 0,
-                coarsened: 0,
-                flat_tops: 0,
-            };
+            let plan = SlabPlan::moving_to(proposed.clone());
             if guard.is_stale(k, &plan) {
                 let end: Vec<DVec3> = (0..6)
                     .map(|c| {

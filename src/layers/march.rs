@@ -19,7 +19,7 @@ use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
 use super::split::{self, Adapt, Sizes, Splits, NONE};
 use super::swap::{self, SwapRole, Swaps};
-use super::{coarsen, entropy};
+use super::{bend, coarsen, entropy};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::CellPoints;
@@ -46,6 +46,9 @@ pub struct MarchStats {
     pub tangential_collapses: usize,
     /// Of the collapses where fronts met, those of faces left flat along a line.
     pub flat_top_collapses: usize,
+    /// Columns turned towards their neighbours' direction to mend an invalid cell, instead of
+    /// stopping.
+    pub bent_columns: usize,
     /// Long front edges left unsplit for a layer because the split would have made an invalid
     /// cell.
     pub splits_given_up: usize,
@@ -144,6 +147,25 @@ pub(super) struct SlabPlan {
     pub coarsened: usize,
     /// Of those, the collapses of faces left flat along a line ([`entropy::merge_flat_tops`]).
     pub flat_tops: usize,
+    /// Columns bent to mend an invalid cell ([`bend::bend_to_mend`]).
+    pub bends: usize,
+}
+
+#[cfg(test)]
+impl SlabPlan {
+    /// A plan moving every column to its `proposed` top, nothing merged yet.
+    pub(super) fn moving_to(proposed: Vec<DVec3>) -> SlabPlan {
+        SlabPlan {
+            moving: vec![true; proposed.len()],
+            merges: Merges::new(proposed.len()),
+            proposed,
+            redirected: Vec::new(),
+            collapses: 0,
+            coarsened: 0,
+            flat_tops: 0,
+            bends: 0,
+        }
+    }
 }
 
 impl SlabPlan {
@@ -397,6 +419,7 @@ pub fn march(
         stats.collapses += plan.collapses - plan.coarsened;
         stats.tangential_collapses += plan.coarsened;
         stats.flat_top_collapses += plan.flat_tops;
+        stats.bent_columns += plan.bends;
         let (split_count, swap_count) =
             commit_slab(mesh, columns, front, &plan, &reshape, sizes, k, &mut stats);
         stats.splits += split_count;
@@ -578,6 +601,7 @@ fn settle_slab(
         collapses: 0,
         coarsened: 0,
         flat_tops: 0,
+        bends: 0,
     };
     {
         let invalid_cells =
@@ -721,6 +745,13 @@ fn repair_invalid_cells(
                     invalid_cells_around(plan, reshape, mesh, columns, front, group)
                 };
                 if let Some(root) = entropy::merge_to_mend(plan, front, f, columns, &invalid_cells) {
+                    changed.extend(plan.merges.group(root));
+                    continue;
+                }
+                let face_valid = |plan: &SlabPlan| face_cell_is_valid(plan, reshape, mesh, columns, front, f);
+                if let Some(root) =
+                    bend::bend_to_mend(plan, front, f, columns, &mesh.points, &face_valid, &invalid_cells)
+                {
                     changed.extend(plan.merges.group(root));
                     continue;
                 }

@@ -4,6 +4,7 @@
 //! mesh: the wall points, the layer cells (zone [`march::LAYER_ZONE`]), the wall faces under
 //! them and the final front as the boundary patch [`TOP_PATCH`].
 
+pub mod bend;
 pub mod coarsen;
 pub mod collapse;
 pub mod entropy;
