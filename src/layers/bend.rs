@@ -1,13 +1,14 @@
 //! Bending a column to mend an invalid cell, the repair before stopping columns.
 //!
-//! Where the wall is finer than a layer is high (the ONERA M6 tip, 0.3 mm tall under a 1.7 mm
-//! first layer) or the front is crumpled (a valley, a saddle corner), the directions of
-//! neighbouring columns can differ by more than their cells stand: a column's cell turns inside
-//! out although no edge is crushed and no bisector is passed. Stopping its columns leaves a
-//! cliff in the front, and the core fills a cliff with slivers. Turning the column part of the
-//! way to the mean direction of its neighbours (a step of Laplacian smoothing of the direction
-//! field, as advancing-layer methods smooth their normals) often mends the cell; the column
-//! keeps its step length and marches on in its new direction.
+//! Where the front is crumpled (spot's valleys, the arrow's fin roots just ahead of their
+//! trailing edges and at their leading edges), the directions of neighbouring columns can differ
+//! by more than their cells stand: a column's cell turns inside out although no edge is crushed
+//! and no bisector is passed. Stopping its columns leaves a cliff in the front, and the core
+//! fills a cliff with slivers. Turning the column part of the way to the mean direction of its
+//! neighbours (a step of Laplacian smoothing of the direction field, as advancing-layer methods
+//! smooth their normals) often mends the cell; the column keeps its step length and marches on
+//! in its new direction. (It does not mend the ONERA M6 wing-tip cap, faceted 5 times finer
+//! than its first layer: the cells that fail there are fan cells.)
 
 use super::entropy::neighbour_roots;
 use super::front::{Columns, Front};

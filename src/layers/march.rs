@@ -151,14 +151,14 @@ pub(super) struct SlabPlan {
     pub bends: usize,
 }
 
-#[cfg(test)]
 impl SlabPlan {
-    /// A plan moving every column to its `proposed` top, nothing merged yet.
-    pub(super) fn moving_to(proposed: Vec<DVec3>) -> SlabPlan {
+    /// A plan moving the columns marked `moving` to their `proposed` tops, nothing merged yet.
+    fn new(moving: Vec<bool>, proposed: Vec<DVec3>) -> SlabPlan {
+        let merges = Merges::new(moving.len());
         SlabPlan {
-            moving: vec![true; proposed.len()],
-            merges: Merges::new(proposed.len()),
+            moving,
             proposed,
+            merges,
             redirected: Vec::new(),
             collapses: 0,
             coarsened: 0,
@@ -166,9 +166,13 @@ impl SlabPlan {
             bends: 0,
         }
     }
-}
 
-impl SlabPlan {
+    /// A plan moving every column to its `proposed` top.
+    #[cfg(test)]
+    pub(super) fn moving_to(proposed: Vec<DVec3>) -> SlabPlan {
+        SlabPlan::new(vec![true; proposed.len()], proposed)
+    }
+
     /// The top node of column `c` in the proposal's numbering.
     fn top(&self, c: u32, columns: &Columns, committed: u32) -> u32 {
         let r = self.merges.root(c);
@@ -593,16 +597,7 @@ fn settle_slab(
     guard: &mut CrossingGuard,
     k: u32,
 ) -> SlabPlan {
-    let mut plan = SlabPlan {
-        moving: columns.alive.clone(),
-        proposed,
-        merges: Merges::new(columns.len()),
-        redirected: Vec::new(),
-        collapses: 0,
-        coarsened: 0,
-        flat_tops: 0,
-        bends: 0,
-    };
+    let mut plan = SlabPlan::new(columns.alive.clone(), proposed);
     {
         let invalid_cells =
             |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
