@@ -63,9 +63,9 @@ pub(super) fn bend_to_mend(
 
 /// Whether column `c` is joined to another by a fan edge.
 fn in_a_fan(front: &Front, columns: &Columns, c: u32) -> bool {
-    let mut next = Vec::new();
-    front.neighbours(c as usize, &mut next);
-    next.iter().any(|&m| columns.is_fan_edge(c as usize, m))
+    let mut mates = Vec::new();
+    front.fan_mates(columns, c as usize, &mut mates);
+    !mates.is_empty()
 }
 
 /// The mean direction of the roots next to root `r`'s group across front edges, `None` when

@@ -564,8 +564,7 @@ fn try_collapse_with_fan_mates(
     accept: &impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> Option<u32> {
     let mut mates = Vec::new();
-    front.neighbours(c as usize, &mut mates);
-    mates.retain(|&m| columns.is_fan_edge(c as usize, m));
+    front.fan_mates(columns, c as usize, &mut mates);
     if mates.is_empty() {
         return None;
     }

@@ -360,6 +360,14 @@ impl Front {
         }
     }
 
+    /// Put in `out` (cleared first) the fan mates of column `c`: its neighbours across fan edges
+    /// ([`Columns::is_fan_edge`]), as [`Front::neighbours`] lists them.
+    pub fn fan_mates(&self, columns: &Columns, c: usize, out: &mut Vec<usize>) {
+        out.clear();
+        self.neighbours(c, out);
+        out.retain(|&m| columns.is_fan_edge(c, m));
+    }
+
     /// The faces touching any of `columns`, each once.
     pub fn faces_around_columns(&self, columns: &[u32]) -> Vec<usize> {
         let mut faces: Vec<usize> = columns.iter().flat_map(|&c| self.faces_of(c)).collect();

@@ -85,9 +85,10 @@ fn reaches_medial_surface(
     // fraction of its width and cannot be built (the flange's 1 mm bore: six layers reach 75%
     // of its radius, a seventh would reach 97%). Where the wall across faces back and the
     // front closes, two layers short of the medial surface is as far as it goes.
-    let closes = closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across);
-    let reach = if closes { next + height(k + 2) } else { next };
-    rise + columns.scale[carrier] * reach >= 0.5 * across
+    let reaches = |layers: f64| rise + columns.scale[carrier] * layers >= 0.5 * across;
+    reaches(next)
+        || (reaches(next + height(k + 2))
+            && closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across))
 }
 
 /// Tilt (degrees) of the rays that probe whether the wall across curves around a column.

@@ -844,14 +844,12 @@ fn stop_fewest_columns(
 
 /// Add to `group` the fan mates of its columns: the columns joined to them by fan edges.
 fn add_fan_mates(front: &Front, columns: &Columns, group: &mut Vec<u32>) {
-    let mut next = Vec::new();
+    let mut mates = Vec::new();
     let mut i = 0;
     while i < group.len() {
-        let c = group[i] as usize;
-        next.clear();
-        front.neighbours(c, &mut next);
-        for &m in &next {
-            if columns.is_fan_edge(c, m) && !group.contains(&(m as u32)) {
+        front.fan_mates(columns, group[i] as usize, &mut mates);
+        for &m in &mates {
+            if !group.contains(&(m as u32)) {
                 group.push(m as u32);
             }
         }
