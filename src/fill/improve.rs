@@ -4,10 +4,11 @@
 //! rings), smoothing of the points the mesher added ([`TetMesh::smooth_vertex`]) and insertion of
 //! points on interior edges ([`TetMesh::split_edge`]).
 //!
-//! The boundary never changes: an operator removes only faces with a tetrahedron on both sides
-//! and edges with a closed ring of tetrahedra around them (so every boundary triangle stays a
-//! face of the cavity it rebuilds), moves only points above the fixed boundary points, and adds
-//! points only inside. Every tetrahedron it creates is positive by the exact `orient3d`. The
+//! The boundary's triangles never change: an operator removes only faces with a tetrahedron on
+//! both sides and edges with a closed ring of tetrahedra around them (so every boundary triangle
+//! stays a face of the cavity it rebuilds), moves only points above the fixed boundary points
+//! (and, to mend a sliver, front points down their columns: [`slide`]), and adds points only
+//! inside. Every tetrahedron it creates is positive by the exact `orient3d`. The
 //! quality is the smallest dihedral angle; an operator is applied only when it raises the
 //! smallest angle of the tetrahedra it replaces.
 
@@ -24,6 +25,8 @@ use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::{triangle_area_vector, DVec3};
 use crate::mesh::{sorted_edge, CellKind};
 use crate::quality::measures::{dihedral_range, edge_face_pairs};
+
+pub use slide::{FrontSlides, MAX_SINK};
 
 /// Quality of a flat or inverted tetrahedron: below every real angle.
 const INVALID: f64 = -1.0;
@@ -109,6 +112,9 @@ pub struct ImproveStats {
     /// Flips and moves that gave a first core tetrahedron the last layer's height
     /// ([`TetMesh::match_front`]).
     pub front_matches: usize,
+    /// Front points moved to mend a sliver: columns' tops down their last step, pyramids'
+    /// apexes ([`TetMesh::move_front_point`]).
+    pub moved_front_points: usize,
     pub passes: usize,
     pub seconds: f64,
 }
@@ -177,6 +183,9 @@ pub struct TetMesh {
     /// the first core tetrahedron's height over it is kept in ([`TetMesh::keep_front_match`]).
     front_height: HashMap<[u32; 3], f64>,
     band: f64,
+    /// The front points that may slide down their columns, with the cells outside the core at
+    /// them ([`TetMesh::allow_front_slides`]); none: the boundary never moves.
+    slides: Option<FrontSlides>,
 }
 
 impl TetMesh {
@@ -189,7 +198,16 @@ impl TetMesh {
             }
         }
         let alive = vec![true; tets.len()];
-        TetMesh { points, tets, alive, ball, fixed, front_height: HashMap::new(), band: f64::INFINITY }
+        TetMesh {
+            points,
+            tets,
+            alive,
+            ball,
+            fixed,
+            front_height: HashMap::new(),
+            band: f64::INFINITY,
+            slides: None,
+        }
     }
 
     /// Refuse every change that leaves more tetrahedra on the front triangles of
@@ -760,6 +778,14 @@ impl TetMesh {
             stats.smoothed_points += 1;
             return Some(change);
         }
+        // The front moves only to mend a sliver.
+        if self.quality(tet) < SLIVER_THRESHOLD {
+            let moves = tet.iter().filter_map(|&v| self.move_front_point(v)).collect();
+            if let Some(change) = self.best_improving(moves, rule) {
+                stats.moved_front_points += 1;
+                return Some(change);
+            }
+        }
         // Insertion under the worst-first rule trades one sliver for many slightly better ones.
         if !options.insert_points || rule == Rule::WorstFirst {
             return None;
@@ -1170,14 +1196,16 @@ pub const SLIVER_THRESHOLD: f64 = 10.0;
 const MATCH_ROUNDS: usize = 6;
 
 /// Improve the mesher's tetrahedra (`core`, filling `boundary`, whose points come first; they
-/// and the next up to `fixed` stay) and measure them before and after. `prism_height` is the
-/// last layer's height under every boundary triangle (NaN where none): the first core
-/// tetrahedra on them keep their match ([`TetMesh::keep_front_match`]).
+/// and the next up to `fixed` stay, but for the front points `slides` lets slide, which move in
+/// `boundary` too) and measure them before and after. `prism_height` is the last layer's height
+/// under every boundary triangle (NaN where none): the first core tetrahedra on them keep their
+/// match ([`TetMesh::keep_front_match`]).
 pub fn improve_core(
-    boundary: &ClosedBoundary,
+    boundary: &mut ClosedBoundary,
     core: CoreTets,
     fixed: usize,
     prism_height: &[f64],
+    slides: Option<FrontSlides>,
     options: &ImproveOptions,
 ) -> (CoreTets, CoreQuality) {
     let worst = |points: &[DVec3], tets: &[[u32; 4]]| {
@@ -1194,8 +1222,13 @@ pub fn improve_core(
         .map(|(&t, &h)| (sorted_triangle(t), h))
         .collect();
     mesh.keep_front_match(front_height, options.size_band);
+    if let Some(slides) = slides {
+        mesh.allow_front_slides(slides);
+    }
     let improvement = mesh.improve(options);
     let (points, tets) = mesh.into_parts();
+    let n = boundary.points.len();
+    boundary.points.copy_from_slice(&points[..n]);
     let core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };
     let quality = CoreQuality {
         mesher_min_dihedral,
@@ -1208,5 +1241,6 @@ pub fn improve_core(
     (core, quality)
 }
 
+mod slide;
 #[cfg(test)]
 mod tests;

@@ -136,6 +136,10 @@ fn check_tets_positive(core: &CoreTets) -> Result<(), FillError> {
 /// Append the mesher's points and tetrahedra (boundary point `i` is mesh node `nodes[i]`).
 pub(super) fn merge(build: CoreBuild, nodes: &[u32], core: &CoreTets) -> (VolumeMesh, CoreStats) {
     let CoreBuild { mut mesh, core_zone, pyramids, .. } = build;
+    // The front points the improvement slid down their columns.
+    for (&m, &p) in nodes.iter().zip(&core.points) {
+        mesh.points[m as usize] = p;
+    }
     let offset = mesh.points.len() as u32;
     let n = nodes.len() as u32;
     mesh.points.extend_from_slice(&core.points[nodes.len()..]);

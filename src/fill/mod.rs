@@ -414,7 +414,7 @@ pub fn fill_core_with_symmetry(
         }
         (None, None) => {}
     }
-    let (boundary, nodes) = core.closed_boundary();
+    let (mut boundary, nodes) = core.closed_boundary();
     let front_layer = core.front_layer(&nodes, false);
     let mesher_start = Instant::now();
     let (tets, seeds_used, seeds, mesher_crashes) = if options.seed_front {
@@ -426,8 +426,15 @@ pub fn fill_core_with_symmetry(
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     // The seeds stay where they are: they give the first core cells the last layer's height.
     let fixed = boundary.points.len() + seeds_used;
-    let (tets, quality) =
-        improve::improve_core(&boundary, tets, fixed, &front_layer.heights, &options.improve);
+    let slides = improve::FrontSlides::new(&boundary, &front_layer.steps, &core.mesh, &nodes);
+    let (tets, quality) = improve::improve_core(
+        &mut boundary,
+        tets,
+        fixed,
+        &front_layer.heights,
+        Some(slides),
+        &options.improve,
+    );
     merge::check_boundary_kept(&boundary, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
     stats.quality = quality;
