@@ -372,7 +372,7 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
 /// stepped down to their stopped neighbours), so the angle bar is not asserted, only that the
 /// steps stay mended, and that the final front's caps and folds (core-side angle below 40
 /// degrees) are mostly undone (47 -> 28; counted below 20 degrees they went 15 -> 0): its 4-degree fold
-/// held a 0.02-degree sliver; the worst was 4.5 degrees then, 6.6 since front points move to
+/// held a 0.02-degree sliver; the worst was 4.5 degrees then, 5.7 since front points move to
 /// mend slivers (columns' tops down their last step, pyramids' apexes).
 #[test]
 fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
@@ -387,7 +387,7 @@ fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     assert!(core.quality.slivers.count <= 8, "{} tetrahedra below 10 deg", core.quality.slivers.count);
     let unfold = &out.report.layers.unfold;
     assert!(unfold.defects_after * 3 <= unfold.defects_before * 2, "{unfold:?}");
-    assert!(core.quality.min_dihedral > 5.5, "core min dihedral {:.2}", core.quality.min_dihedral);
+    assert!(core.quality.min_dihedral > 5.0, "core min dihedral {:.2}", core.quality.min_dihedral);
     assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
     let on_prisms = core.size_jump.on_prisms.within_band;
     assert!(on_prisms >= 0.95, "{:.1}% within [1/r, r] on prisms", 100.0 * on_prisms);

@@ -5,8 +5,8 @@
 //! its plane, where the front is crumpled) has no interior face or edge whose flip mends it and
 //! no room for a point. Lowering one of its front points along the last step of its column
 //! lifts it out of that plane. The last layer gets shorter by at most [`MAX_SINK`] of its step,
-//! so the layer heights still grow by no more than the growth ratio (DESIGN.md, smoothness) and
-//! the stack keeps at least 95% of its thickness. Every cell outside the core at the point (the
+//! no more than keeps it within the growth ratio of the layer under it (DESIGN.md,
+//! smoothness), and the stack loses at most [`MAX_THINNING`] of its thickness. Every cell outside the core at the point (the
 //! layer cells and the pyramids on the front's quads) must stay valid by the checker's exact
 //! test, and the tetrahedra at it positive: the point stays inside its star, so the mesh stays
 //! a partition of the domain.
@@ -17,12 +17,17 @@ use super::{Change, TetMesh};
 use crate::fill::{ClosedBoundary, MARKER_FRONT};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
+use crate::quality::measures::quad_centre;
 use crate::quality::validity::cell_validity;
 
 /// How far down its last step a front point may slide (fraction of the step; less when the
-/// growth ratio r is below 1.12, see [`TetMesh::max_sink`]): at 0.2 a stack of 10 layers at
-/// growth 1.2 loses at most 4% of its thickness.
+/// growth ratio r is below 1.12, see [`TetMesh::max_sink`], or the stack is thin).
 pub const MAX_SINK: f64 = 0.2;
+
+/// The most of its stack's thickness a slide may take (the stack is measured down the
+/// prisms' vertical edges under the point; `shared/bench/measure.py` counts a column covered
+/// from 95% of its thickness).
+pub const MAX_THINNING: f64 = 0.03;
 
 /// Places tried along the path, evenly spaced down to [`MAX_SINK`].
 const SINK_STEPS: usize = 8;
@@ -31,14 +36,24 @@ const SINK_STEPS: usize = 8;
 #[derive(Clone, Copy, Debug)]
 enum Freedom {
     Fixed,
-    /// Down the last step of its column, from where it was built.
+    /// Down the last step of its column, from where it was built, by at most `reach` of it
+    /// ([`MAX_SINK`], less on a thin stack).
     Column {
         origin: DVec3,
         step: DVec3,
+        reach: f64,
     },
-    /// Anywhere its cells stay valid: the apex of a pyramid on a front quad (it is a point of
-    /// the core, on the boundary only because the mesher takes triangles).
-    Free,
+    /// Anywhere its cells stay valid and its height over the plane through `centre` normal
+    /// to `normal` within the size band of `height`, where it was built: the apex of a
+    /// pyramid on a front quad (a point of the core, on the boundary only because the mesher
+    /// takes triangles; its height matches the last layer under the quad).
+    Apex {
+        centre: DVec3,
+        normal: DVec3,
+        height: f64,
+    },
+    /// Not known yet: a point with no column under it, an apex if only pyramids have it so.
+    Unknown,
 }
 
 /// The front points that may move, and the cells outside the core at them.
@@ -59,10 +74,14 @@ impl FrontSlides {
     /// cells of `mesh` at them. A point on a boundary triangle that is not the front's stays.
     pub fn new(boundary: &ClosedBoundary, steps: &[DVec3], mesh: &VolumeMesh, nodes: &[u32]) -> FrontSlides {
         let n = boundary.points.len();
+        let stack = StackHeights::of(mesh);
         let mut freedom: Vec<Freedom> = (0..n)
             .map(|i| match steps.get(i) {
-                Some(&step) if step.is_finite() => Freedom::Column { origin: boundary.points[i], step },
-                _ => Freedom::Free,
+                Some(&step) if step.is_finite() && step != DVec3::ZERO => {
+                    let thinning = MAX_THINNING * stack.under(nodes[i]) / step.length();
+                    Freedom::Column { origin: boundary.points[i], step, reach: MAX_SINK.min(thinning) }
+                }
+                _ => Freedom::Unknown,
             })
             .collect();
         for (t, &marker) in boundary.triangles.iter().zip(&boundary.markers) {
@@ -75,30 +94,29 @@ impl FrontSlides {
         let mut local: HashMap<u32, u32> = nodes.iter().enumerate().map(|(i, &m)| (m, i as u32)).collect();
         let mut slides = FrontSlides { freedom, ..Default::default() };
         // (apex of a pyramid, in another cell) for every boundary point.
-        let mut seen = vec![(false, false); n];
+        // (the apex's freedom in the last pyramid it tops, whether it is in another cell)
+        let mut seen = vec![(None, false); n];
         for (kind, cell) in mesh.cells() {
             for (k, m) in cell.iter().enumerate() {
-                if let Some(&i) = local.get(m).filter(|&&i| (i as usize) < n) {
-                    let apex = kind == CellKind::Pyramid && k == 4;
-                    let (as_apex, otherwise) = &mut seen[i as usize];
-                    *as_apex |= apex;
-                    *otherwise |= !apex;
+                let Some(&i) = local.get(m).filter(|&&i| (i as usize) < n) else { continue };
+                let (as_apex, otherwise) = &mut seen[i as usize];
+                if kind == CellKind::Pyramid && k == 4 {
+                    *as_apex = Some(apex_freedom(std::array::from_fn(|j| mesh.points[cell[j] as usize])));
+                } else {
+                    *otherwise = true;
                 }
             }
         }
         for (f, seen) in slides.freedom.iter_mut().zip(seen) {
-            if matches!(f, Freedom::Free) && seen != (true, false) {
-                *f = Freedom::Fixed;
+            if matches!(f, Freedom::Unknown) {
+                *f = match seen {
+                    (Some(apex), false) => apex,
+                    _ => Freedom::Fixed,
+                };
             }
         }
         for (kind, cell) in mesh.cells() {
-            let moves = |m: &u32| {
-                local
-                    .get(m)
-                    .and_then(|&i| slides.freedom.get(i as usize))
-                    .is_some_and(|f| !matches!(f, Freedom::Fixed))
-            };
-            if !cell.iter().any(moves) {
+            if !cell.iter().any(|m| local.get(m).is_some_and(|&i| slides.moves(i))) {
                 continue;
             }
             let mut corners = [0u32; 8];
@@ -110,13 +128,18 @@ impl FrontSlides {
             }
             let c = slides.cells.len() as u32;
             for &v in corners[..kind.node_count()].iter().filter(|&&v| (v as usize) < n) {
-                if !matches!(slides.freedom[v as usize], Freedom::Fixed) {
+                if slides.moves(v) {
                     slides.cells_at.entry(v).or_default().push(c);
                 }
             }
             slides.cells.push((kind, corners));
         }
         slides
+    }
+
+    /// Whether boundary point `v` may move (false for the other points).
+    fn moves(&self, v: u32) -> bool {
+        self.freedom.get(v as usize).is_some_and(|f| !matches!(f, Freedom::Fixed | Freedom::Unknown))
     }
 
     /// Whether every cell outside the core at point `v` is valid with `v` at `p` (the other
@@ -141,6 +164,39 @@ impl FrontSlides {
     }
 }
 
+/// The freedom of the apex of the pyramid `x` (its base, then its apex).
+fn apex_freedom(x: [DVec3; 5]) -> Freedom {
+    let centre = quad_centre(x[0], x[1], x[2], x[3]);
+    let normal = (x[2] - x[0]).cross(x[3] - x[1]).normalize_or_zero();
+    Freedom::Apex { centre, normal, height: (x[4] - centre).dot(normal) }
+}
+
+/// The height of the stack of prisms under every node: the lengths of their vertical edges,
+/// followed down to the wall (or to a cell that is not a prism).
+struct StackHeights<'a> {
+    below: HashMap<u32, u32>,
+    points: &'a [DVec3],
+}
+
+impl StackHeights<'_> {
+    fn of(mesh: &VolumeMesh) -> StackHeights<'_> {
+        let prisms = mesh.block(CellKind::Prism);
+        let below = prisms.iter().flat_map(|p| (0..3).map(move |i| (p[i + 3], p[i]))).collect();
+        StackHeights { below, points: &mesh.points }
+    }
+
+    fn under(&self, top: u32) -> f64 {
+        let (mut height, mut at) = (0.0, top);
+        // No stack has more layers than the mesh has points (a guard against a cycle).
+        for _ in 0..self.points.len() {
+            let Some(&next) = self.below.get(&at) else { break };
+            height += self.points[at as usize].distance(self.points[next as usize]);
+            at = next;
+        }
+        height
+    }
+}
+
 impl TetMesh {
     /// Let the front points move ([`TetMesh::move_front_point`]).
     pub fn allow_front_slides(&mut self, slides: FrontSlides) {
@@ -155,26 +211,30 @@ impl TetMesh {
 
     /// Move front point `v` where the worst tetrahedron at it is best and every cell outside
     /// the core at it stays valid: a column's top down its last step (to [`MAX_SINK`] of it),
-    /// a pyramid's apex anywhere (hill climbing, then back towards where it was until its
-    /// pyramid is valid). `None` when it may not move or no other place keeps them valid.
+    /// a pyramid's apex where its height over the quad stays in the size band (hill climbing,
+    /// then back towards where it was until its pyramid is valid). `None` when it may not move or no other place keeps them valid.
     pub fn move_front_point(&self, v: u32) -> Option<Change> {
         let slides = self.slides.as_ref()?;
         let ball = self.ball_of(v);
         let here = self.points[v as usize];
         let valid = |p: &DVec3| *p != here && slides.cells_stay_valid(v, *p, &self.points);
         let best = match *slides.freedom.get(v as usize)? {
-            Freedom::Fixed => return None,
-            Freedom::Column { origin, step } => {
+            Freedom::Fixed | Freedom::Unknown => return None,
+            Freedom::Column { origin, step, reach } => {
                 (0..=SINK_STEPS)
-                    .map(|k| origin - step * (self.max_sink() * k as f64 / SINK_STEPS as f64))
+                    .map(|k| origin - step * (self.max_sink().min(reach) * k as f64 / SINK_STEPS as f64))
                     .filter(valid)
                     .map(|p| (self.ball_quality(&ball, v, p), p))
                     .max_by(|x, y| x.0.total_cmp(&y.0))?
                     .1
             }
-            Freedom::Free => {
+            Freedom::Apex { centre, normal, height } => {
+                let in_band = |p: &DVec3| {
+                    let h = (*p - centre).dot(normal);
+                    h >= height / self.band && h <= height * self.band
+                };
                 let (p, _) = self.best_position(&ball, v, here);
-                (0..4).map(|k| here.lerp(p, 0.5f64.powi(k))).find(valid)?
+                (0..4).map(|k| here.lerp(p, 0.5f64.powi(k))).filter(in_band).find(valid)?
             }
         };
         Some(self.point_move(&ball, v, best))
@@ -188,30 +248,40 @@ mod tests {
     use crate::fill::MARKER_FARFIELD;
     use crate::quality::validity::gather;
 
-    /// A front triangle (0, 1, 2) at z = 0 on a prism one high, and a front point (3) of no
-    /// column 0.05 over the triangle's centre: the core tetrahedron on them is a flat sliver.
-    fn flat_cap() -> (TetMesh, ClosedBoundary, VolumeMesh, Vec<u32>) {
+    /// A front triangle (0, 1, 2) at z = 0 on a stack of prisms down to the heights `levels`
+    /// (the last step is 1 high whatever they are), and a front point (3) of no column 0.05
+    /// over the triangle's centre: the core tetrahedron on them is a flat sliver.
+    fn flat_cap(levels: &[f64]) -> (TetMesh, ClosedBoundary, VolumeMesh, Vec<u32>) {
         let s = 3f64.sqrt();
         let top = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, s / 2.0, 0.0)];
         let apex = DVec3::new(0.5, s / 6.0, 0.05);
-        let points = top.iter().map(|p| *p - DVec3::Z).chain(top).chain([apex]).collect();
+        let at = |z: f64| top.map(|p| p + z * DVec3::Z);
+        let points = top.into_iter().chain([apex]).chain(levels.iter().flat_map(|&z| at(z))).collect();
         let mut mesh = VolumeMesh { points, ..Default::default() };
-        mesh.push_cell(CellKind::Prism, &[0, 1, 2, 3, 4, 5], 0);
+        let level = |l: usize| [0u32, 1, 2].map(|i| if l == 0 { i } else { 4 + 3 * (l as u32 - 1) + i });
+        for l in 0..levels.len() {
+            let (upper, lower) = (level(l), level(l + 1));
+            mesh.push_cell(CellKind::Prism, &[lower, upper].concat(), 0);
+        }
         let boundary = ClosedBoundary {
             points: top.into_iter().chain([apex]).collect(),
             triangles: vec![[0, 1, 2]],
             markers: vec![MARKER_FRONT],
         };
         let core = TetMesh::new(boundary.points.clone(), vec![[0, 1, 2, 3]], 4);
-        (core, boundary, mesh, vec![3, 4, 5, 6])
+        (core, boundary, mesh, vec![0, 1, 2, 3])
     }
+
+    /// Ten layers one high.
+    const TEN: [f64; 10] = [-1.0, -2.0, -3.0, -4.0, -5.0, -6.0, -7.0, -8.0, -9.0, -10.0];
 
     fn steps() -> Vec<DVec3> {
         vec![DVec3::Z, DVec3::Z, DVec3::Z, DVec3::NAN]
     }
 
     fn prism_valid(slides: &FrontSlides, core: &TetMesh) -> bool {
-        let (kind, nodes) = slides.cells[0];
+        let (kind, nodes) =
+            slides.cells_at[&0].iter().map(|&c| slides.cells[c as usize]).next().expect("a prism");
         let mut points: Vec<DVec3> = core.points.clone();
         points.extend(&slides.outer_points);
         cell_validity(kind, &gather(&points, &nodes[..6]).expect("in range")).is_valid()
@@ -219,7 +289,7 @@ mod tests {
 
     #[test]
     fn a_front_sliver_is_mended_by_sinking_a_top_down_its_column() {
-        let (mut core, boundary, mesh, nodes) = flat_cap();
+        let (mut core, boundary, mesh, nodes) = flat_cap(&TEN);
         core.keep_front_match(HashMap::new(), 1.2);
         let slides = FrontSlides::new(&boundary, &steps(), &mesh, &nodes);
         core.allow_front_slides(slides);
@@ -247,7 +317,7 @@ mod tests {
 
     #[test]
     fn a_top_stays_where_its_layer_would_outgrow_the_one_under_it_or_on_another_boundary() {
-        let (mut core, mut boundary, mesh, nodes) = flat_cap();
+        let (mut core, mut boundary, mesh, nodes) = flat_cap(&TEN);
         // Growth 1.05: the last layer may lose 1 - 1/1.05^2 (9.3%) of its step, no more.
         core.keep_front_match(HashMap::new(), 1.05);
         core.allow_front_slides(FrontSlides::new(&boundary, &steps(), &mesh, &nodes));
@@ -263,12 +333,10 @@ mod tests {
 
     #[test]
     fn a_top_never_slides_where_its_prism_turns_over() {
-        let (mut core, boundary, mut mesh, nodes) = flat_cap();
-        // The prism is one tenth as high as the step says: sinking by 0.2 puts the top
-        // under its bottom.
-        for p in &mut mesh.points[..3] {
-            p.z = -0.1;
-        }
+        // The last prism is a tenth as high as its step says: a sink of 0.2 of the step puts
+        // the top under its bottom.
+        let levels: Vec<f64> = [-0.1].into_iter().chain(TEN[..9].iter().copied()).collect();
+        let (mut core, boundary, mesh, nodes) = flat_cap(&levels);
         core.keep_front_match(HashMap::new(), 1.2);
         let slides = FrontSlides::new(&boundary, &steps(), &mesh, &nodes);
         assert!(slides.cells_stay_valid(0, DVec3::new(0.0, 0.0, -0.05), &core.points));
@@ -276,6 +344,16 @@ mod tests {
         core.allow_front_slides(slides);
         let p = core.move_front_point(0).and_then(|c| c.point).expect("a move").1;
         assert!(p.z > -0.1, "{p}");
+    }
+
+    /// On a stack of one layer, a top may take 3% of its thickness, not 20% of its step.
+    #[test]
+    fn a_thin_stack_loses_little_of_its_thickness() {
+        let (mut core, boundary, mesh, nodes) = flat_cap(&[-1.0]);
+        core.keep_front_match(HashMap::new(), 1.2);
+        core.allow_front_slides(FrontSlides::new(&boundary, &steps(), &mesh, &nodes));
+        let p = core.move_front_point(0).and_then(|c| c.point).expect("a move").1;
+        assert!(p.z >= -MAX_THINNING - 1e-12 && p.z < 0.0, "{p}");
     }
 
     /// The apex of a pyramid on a front quad (a point of the core the mesher sees as
@@ -294,7 +372,7 @@ mod tests {
             markers: vec![MARKER_FRONT; 4],
         };
         let slides = FrontSlides::new(&boundary, &[DVec3::NAN; 5], &mesh, &[0, 1, 2, 3, 4]);
-        assert!(matches!(slides.freedom[4], Freedom::Free));
+        assert!(matches!(slides.freedom[4], Freedom::Apex { height: 0.5, .. }));
         assert!(slides.freedom[..4].iter().all(|f| matches!(f, Freedom::Fixed)));
         let at = |z: f64| slides.cells_stay_valid(4, DVec3::new(0.3, 0.6, z), &boundary.points);
         assert!(at(0.2) && at(2.0));
