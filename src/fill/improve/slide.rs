@@ -4,18 +4,21 @@
 //! A sliver whose four nodes are all on the front (a front triangle and a front point nearly in
 //! its plane, where the front is crumpled) has no interior face or edge whose flip mends it and
 //! no room for a point. Lowering one of its front points along the last step of its column
-//! lifts it out of that plane. The last layer gets shorter by at most [`MAX_SINK`] of its step,
-//! no more than keeps it within the growth ratio of the layer under it (DESIGN.md,
-//! smoothness), and the stack loses at most [`MAX_THINNING`] of its thickness. Every cell outside the core at the point (the
-//! layer cells and the pyramids on the front's quads) must stay valid by the checker's exact
-//! test, and the tetrahedra at it positive: the point stays inside its star, so the mesh stays
-//! a partition of the domain.
+//! (where columns merged and no prism is under it, along the front's normal by the step of
+//! the columns around it) lifts it out of that plane. The last layer gets shorter by at most
+//! [`MAX_SINK`] of its step, no more than keeps it within the growth ratio of the layer under
+//! it (DESIGN.md, smoothness), and the stack loses at most [`MAX_THINNING`] of its thickness.
+//! A pyramid's apex on a front quad moves too, its height kept in the size band. Every cell
+//! outside the core at the point (the layer cells and the pyramids on the front's quads) must
+//! stay valid by the checker's exact test, and the tetrahedra at it positive: the point stays
+//! inside its star, so the mesh stays a partition of the domain. (The last layer heights the
+//! front match keeps, [`TetMesh::keep_front_match`], are those before any slide.)
 
 use std::collections::HashMap;
 
 use super::{Change, TetMesh};
 use crate::fill::{ClosedBoundary, MARKER_FRONT};
-use crate::geometry::DVec3;
+use crate::geometry::{triangle_area_vector, DVec3};
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
 use crate::quality::validity::cell_validity;
@@ -71,7 +74,8 @@ pub struct FrontSlides {
 impl FrontSlides {
     /// The freedom of the front points of `boundary` (boundary point `i` being node `nodes[i]`
     /// of `mesh`, the mesh around the core, and `steps[i]` its column's last step) and the
-    /// cells of `mesh` at them. A point on a boundary triangle that is not the front's stays.
+    /// cells of `mesh` at them. A point on a boundary triangle that is not the front's, or on
+    /// the boundary of `mesh`, stays.
     pub fn new(boundary: &ClosedBoundary, steps: &[DVec3], mesh: &VolumeMesh, nodes: &[u32]) -> FrontSlides {
         let local: HashMap<u32, u32> = nodes.iter().enumerate().map(|(i, &m)| (m, i as u32)).collect();
         let mut freedom = column_freedom(boundary, steps, mesh, nodes);
@@ -82,7 +86,22 @@ impl FrontSlides {
                 }
             }
         }
+        // A top on the mesh's boundary (a column that slid on a patch without layers, whose
+        // layer faces lie in its plane) stays, even where no core boundary triangle of that
+        // patch reaches it.
+        let faces = &mesh.boundary;
+        for m in faces.triangles.iter().flatten().chain(faces.quads.iter().flatten()) {
+            if let Some(&i) = local.get(m) {
+                freedom[i as usize] = Freedom::Fixed;
+            }
+        }
         settle_apexes(&mut freedom, mesh, &local);
+        borrow_neighbour_columns(&mut freedom, boundary);
+        for f in &mut freedom {
+            if matches!(f, Freedom::Unknown) {
+                *f = Freedom::Fixed;
+            }
+        }
         let mut slides = FrontSlides { freedom, ..Default::default() };
         slides.gather_cells(mesh, local);
         slides
@@ -161,8 +180,8 @@ fn column_freedom(
         .collect()
 }
 
-/// Decide the points of no column: the apex of a pyramid and of no other cell of `mesh` moves
-/// as one ([`apex_freedom`]); any other stays.
+/// The points of no column that are the apex of a pyramid and of no other cell of `mesh` move
+/// as one ([`apex_freedom`]).
 fn settle_apexes(freedom: &mut [Freedom], mesh: &VolumeMesh, local: &HashMap<u32, u32>) {
     // (the apex's freedom in the last pyramid it tops, whether it is in another cell)
     let mut seen = vec![(None, false); freedom.len()];
@@ -179,11 +198,39 @@ fn settle_apexes(freedom: &mut [Freedom], mesh: &VolumeMesh, local: &HashMap<u32
         }
     }
     for (f, seen) in freedom.iter_mut().zip(seen) {
-        if matches!(f, Freedom::Unknown) {
-            *f = match seen {
-                (Some(apex), false) => apex,
-                _ => Freedom::Fixed,
-            };
+        if let (Freedom::Unknown, (Some(apex), false)) = (&f, seen) {
+            *f = apex;
+        }
+    }
+}
+
+/// A front point of no column and no pyramid's apex (where columns merged in the last layers,
+/// over tetrahedra and pyramids) sinks along the front's normal there, as far as the columns
+/// around it on the front may: their mean step, their least reach.
+fn borrow_neighbour_columns(freedom: &mut [Freedom], boundary: &ClosedBoundary) {
+    let n = freedom.len();
+    let mut normal = vec![DVec3::ZERO; n];
+    // (sum of the neighbours' step lengths, their least reach, how many)
+    let mut around = vec![(0.0, f64::INFINITY, 0usize); n];
+    for (t, _) in boundary.triangles.iter().zip(&boundary.markers).filter(|(_, &m)| m == MARKER_FRONT) {
+        let [a, b, c] = t.map(|v| boundary.points[v as usize]);
+        let area = triangle_area_vector(a, b, c);
+        for &v in t {
+            normal[v as usize] += area;
+            for &u in t {
+                if let Freedom::Column { step, reach, .. } = freedom[u as usize] {
+                    let (sum, least, count) = &mut around[v as usize];
+                    (*sum, *least, *count) = (*sum + step.length(), least.min(reach), *count + 1);
+                }
+            }
+        }
+    }
+    for (v, f) in freedom.iter_mut().enumerate() {
+        let (sum, least, count) = around[v];
+        let direction = normal[v].normalize_or_zero();
+        if matches!(f, Freedom::Unknown) && count > 0 && direction != DVec3::ZERO {
+            let step = direction * (sum / count as f64);
+            *f = Freedom::Column { origin: boundary.points[v], step, reach: least };
         }
     }
 }
@@ -378,6 +425,37 @@ mod tests {
         core.allow_front_slides(FrontSlides::new(&boundary, &steps(), &mesh, &nodes));
         let p = core.move_front_point(0).and_then(|c| c.point).expect("a move").1;
         assert!(p.z >= -MAX_THINNING - 1e-12 && p.z < 0.0, "{p}");
+    }
+
+    /// A top whose column slid on a patch without layers is on the mesh's boundary (a layer
+    /// face in the patch's plane): it stays, though only front triangles of the core have it.
+    #[test]
+    fn a_top_on_the_mesh_boundary_stays() {
+        let (_, boundary, mut mesh, nodes) = flat_cap(&TEN);
+        mesh.boundary.quads.push([4, 5, 1, 0]);
+        mesh.boundary.quad_patch.push(0);
+        let slides = FrontSlides::new(&boundary, &steps(), &mesh, &nodes);
+        assert!(slides.freedom[..2].iter().all(|f| matches!(f, Freedom::Fixed)));
+        assert!(matches!(slides.freedom[2], Freedom::Column { .. }));
+    }
+
+    /// A front point with no prism under it (columns merged in the last layer) borrows the
+    /// columns around it on the front: it sinks along the front's normal by their step, no
+    /// further than they may. A front point on no front triangle stays.
+    #[test]
+    fn a_top_of_no_prism_sinks_as_far_as_the_columns_around_it() {
+        let (mut core, boundary, mesh, nodes) = flat_cap(&TEN);
+        let steps = [DVec3::Z, DVec3::Z, DVec3::NAN, DVec3::NAN];
+        let slides = FrontSlides::new(&boundary, &steps, &mesh, &nodes);
+        let Freedom::Column { step, reach, .. } = slides.freedom[2] else {
+            panic!("{:?}", slides.freedom[2])
+        };
+        assert!((step - DVec3::Z).length() < 1e-12 && reach == MAX_SINK, "{step} {reach}");
+        assert!(matches!(slides.freedom[3], Freedom::Fixed));
+        core.keep_front_match(HashMap::new(), 1.2);
+        core.allow_front_slides(slides);
+        let p = core.move_front_point(2).and_then(|c| c.point).expect("a move").1;
+        assert!(p.z >= -MAX_SINK - 1e-12 && p.z < 0.0, "{p}");
     }
 
     /// The apex of a pyramid on a front quad (a point of the core the mesher sees as
