@@ -10,6 +10,31 @@ use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::{dihedral_range, edge_face_pairs};
 
+/// No point of the mesh's boundary faces (the wall, the farfield, the layer faces on patches
+/// without layers) may have moved in the improvement: boundary point `i` is mesh node
+/// `nodes[i]`, at `core.points[i]` now.
+pub(super) fn check_mesh_boundary_kept(
+    build: &CoreBuild,
+    nodes: &[u32],
+    core: &CoreTets,
+) -> Result<(), FillError> {
+    let faces = &build.mesh.boundary;
+    let on_boundary: std::collections::HashSet<u32> =
+        faces.triangles.iter().flatten().chain(faces.quads.iter().flatten()).copied().collect();
+    let moved = nodes
+        .iter()
+        .zip(&core.points)
+        .find(|&(m, p)| build.mesh.points[*m as usize] != *p && on_boundary.contains(m));
+    match moved {
+        Some((&m, p)) => Err(FillError::BadOutput(format!(
+            "mesh boundary node {m} moved from {:?} to {:?} in the core's improvement",
+            build.mesh.points[m as usize].to_array(),
+            p.to_array()
+        ))),
+        None => Ok(()),
+    }
+}
+
 /// The tetrahedra must be positive, keep the boundary points first and unchanged, and have
 /// every boundary triangle as a face of exactly one tetrahedron, on its inner side.
 pub(super) fn check_boundary_kept(boundary: &ClosedBoundary, core: &CoreTets) -> Result<(), FillError> {

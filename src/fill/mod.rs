@@ -436,6 +436,7 @@ pub fn fill_core_with_symmetry(
         &options.improve,
     );
     merge::check_boundary_kept(&boundary, &tets)?;
+    merge::check_mesh_boundary_kept(&core, &nodes, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
     stats.quality = quality;
     stats.seeds = seeds_used;

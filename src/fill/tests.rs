@@ -306,3 +306,17 @@ fn a_mesher_crashing_on_the_seeds_is_run_again_with_fewer_then_none() {
     assert!(seeds.candidates > 0, "the candidates are still reported");
     merge::check_boundary_kept(&boundary, &tets).expect("a whole fill");
 }
+
+/// The safety net under the front slides: a wall point moved by the improvement is an error
+/// naming the node, not a mesh off its input surface.
+#[test]
+fn a_moved_mesh_boundary_point_is_an_error() {
+    let cube = shapes::cuboid(DVec3::splat(1.0), 2);
+    let core = front::core_boundary(&bare_wall(&cube), &cube).expect("a core boundary");
+    let (boundary, nodes) = core.closed_boundary();
+    let mut tets = CoreTets { points: boundary.points.clone(), ..Default::default() };
+    merge::check_mesh_boundary_kept(&core, &nodes, &tets).expect("nothing moved");
+    tets.points[3].z += 1e-3;
+    let err = merge::check_mesh_boundary_kept(&core, &nodes, &tets).expect_err("a wall point moved");
+    assert!(err.to_string().contains(&format!("node {}", nodes[3])), "{err}");
+}
