@@ -18,9 +18,7 @@ pub(super) fn check_mesh_boundary_kept(
     nodes: &[u32],
     core: &CoreTets,
 ) -> Result<(), FillError> {
-    let faces = &build.mesh.boundary;
-    let on_boundary: std::collections::HashSet<u32> =
-        faces.triangles.iter().flatten().chain(faces.quads.iter().flatten()).copied().collect();
+    let on_boundary: std::collections::HashSet<u32> = build.mesh.boundary.nodes().collect();
     let moved = nodes
         .iter()
         .zip(&core.points)

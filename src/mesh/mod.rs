@@ -203,6 +203,13 @@ pub struct BoundaryFaces {
     pub quad_patch: Vec<u32>,
 }
 
+impl BoundaryFaces {
+    /// The nodes of the triangles, then of the quads, face by face (a node once per face).
+    pub fn nodes(&self) -> impl Iterator<Item = u32> + '_ {
+        self.triangles.iter().flatten().chain(self.quads.iter().flatten()).copied()
+    }
+}
+
 /// A hybrid volume mesh.
 #[derive(Clone, Debug)]
 pub struct VolumeMesh {

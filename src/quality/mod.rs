@@ -111,9 +111,7 @@ fn check_structure(mesh: &VolumeMesh, report: &mut CheckReport) {
     count("triangles", b.triangles.len(), &b.triangle_patch, false, report);
     count("quads", b.quads.len(), &b.quad_patch, true, report);
     let points = mesh.points.len();
-    let out_of_range =
-        b.triangles.iter().flatten().chain(b.quads.iter().flatten()).filter(|&&n| n as usize >= points);
-    let out_of_range = out_of_range.count();
+    let out_of_range = b.nodes().filter(|&n| n as usize >= points).count();
     if out_of_range > 0 {
         report
             .structure_errors

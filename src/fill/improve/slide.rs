@@ -89,9 +89,8 @@ impl FrontSlides {
         // A top on the mesh's boundary (a column that slid on a patch without layers, whose
         // layer faces lie in its plane) stays, even where no core boundary triangle of that
         // patch reaches it.
-        let faces = &mesh.boundary;
-        for m in faces.triangles.iter().flatten().chain(faces.quads.iter().flatten()) {
-            if let Some(&i) = local.get(m) {
+        for m in mesh.boundary.nodes() {
+            if let Some(&i) = local.get(&m) {
                 freedom[i as usize] = Freedom::Fixed;
             }
         }

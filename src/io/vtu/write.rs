@@ -62,8 +62,7 @@ pub fn write(w: &mut dyn Write, mesh: &VolumeMesh) -> io::Result<()> {
                 perm.iter().try_for_each(|&p| e.write_all(&i64::from(cell[p]).to_le_bytes()))?;
             }
         }
-        let face_nodes = b.triangles.iter().flatten().chain(b.quads.iter().flatten());
-        face_nodes.into_iter().try_for_each(|&n| e.write_all(&i64::from(n).to_le_bytes()))
+        b.nodes().try_for_each(|n| e.write_all(&i64::from(n).to_le_bytes()))
     })?;
     binary_array(w, "Int64", "offsets", 1, 8 * cells, |e| {
         let sizes = mesh.blocks.iter().flat_map(|b| std::iter::repeat_n(b.kind.node_count(), b.len()));
