@@ -392,12 +392,18 @@ fn triangles_meet(t_ids: [u32; 3], t: [DVec3; 3], u_ids: [u32; 3], u: [DVec3; 3]
 /// Apex heights tried for a pyramid on a front quad: half its shortest edge, then halved.
 const APEX_TRIES: i32 = 6;
 
+/// The centre of the quad `x` and its unit normal (across its diagonals, right-handed): where
+/// [`pyramid_apex`] stands a pyramid's apex over it.
+pub fn quad_frame(x: [DVec3; 4]) -> (DVec3, DVec3) {
+    let centre = quad_centre(x[0], x[1], x[2], x[3]);
+    (centre, (x[2] - x[0]).cross(x[3] - x[1]).normalize_or_zero())
+}
+
 /// The apex of a valid pyramid on the quad `x` (its right-hand normal pointing to the apex):
 /// above the quad's centre at half its shortest edge (fan-strip quads are long and narrow: a
 /// taller apex would poke through the front nearby), or lower where that is invalid.
 pub fn pyramid_apex(x: [DVec3; 4]) -> Option<DVec3> {
-    let centre = quad_centre(x[0], x[1], x[2], x[3]);
-    let normal = (x[2] - x[0]).cross(x[3] - x[1]).normalize_or_zero();
+    let (centre, normal) = quad_frame(x);
     let min_edge = (0..4).map(|i| x[i].distance(x[(i + 1) % 4])).fold(f64::INFINITY, f64::min);
     (0..APEX_TRIES).map(|k| centre + normal * (0.5 * min_edge * 0.5f64.powi(k))).find(|&apex| {
         let mut p = [DVec3::ZERO; 8];

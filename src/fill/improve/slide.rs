@@ -19,8 +19,8 @@ use std::collections::HashMap;
 use super::{Change, TetMesh};
 use crate::fill::{ClosedBoundary, MARKER_FRONT};
 use crate::geometry::{triangle_area_vector, DVec3};
+use crate::layers::guard::quad_frame;
 use crate::mesh::{CellKind, VolumeMesh};
-use crate::quality::measures::quad_centre;
 use crate::quality::validity::cell_validity;
 
 /// How far down its last step a front point may slide (fraction of the step; less when the
@@ -236,8 +236,7 @@ fn borrow_neighbour_columns(freedom: &mut [Freedom], boundary: &ClosedBoundary) 
 
 /// The freedom of the apex of the pyramid `x` (its base, then its apex).
 fn apex_freedom(x: [DVec3; 5]) -> Freedom {
-    let centre = quad_centre(x[0], x[1], x[2], x[3]);
-    let normal = (x[2] - x[0]).cross(x[3] - x[1]).normalize_or_zero();
+    let (centre, normal) = quad_frame([x[0], x[1], x[2], x[3]]);
     Freedom::Apex { centre, normal, height: (x[4] - centre).dot(normal) }
 }
 
@@ -280,9 +279,10 @@ impl TetMesh {
     }
 
     /// Move front point `v` where the worst tetrahedron at it is best and every cell outside
-    /// the core at it stays valid: a column's top down its last step (to [`MAX_SINK`] of it),
-    /// a pyramid's apex where its height over the quad stays in the size band (hill climbing,
-    /// then back towards where it was until its pyramid is valid). `None` when it may not move or no other place keeps them valid.
+    /// the core at it stays valid: a column's top down its last step (as far as its reach and
+    /// the growth ratio allow, [`TetMesh::max_sink`]), a pyramid's apex where its height over
+    /// the quad stays in the size band (hill climbing, then back towards where it was until
+    /// its pyramid is valid). `None` when it may not move or no other place keeps them valid.
     pub fn move_front_point(&self, v: u32) -> Option<Change> {
         let slides = self.slides.as_ref()?;
         let ball = self.ball_of(v);
