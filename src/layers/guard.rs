@@ -27,6 +27,10 @@ use crate::quality::validity::cell_validity;
 /// Layers one set of candidate pairs covers when no collapse changes the front.
 pub const LOOKAHEAD_LAYERS: u32 = 4;
 
+/// Two triangles sharing a vertex whose columns' mean directions make a cosine below this may
+/// fold over it with both cells valid: the front turns sharply there (45 deg).
+const TURNED: f64 = std::f64::consts::FRAC_1_SQRT_2;
+
 /// Candidate pairs of front faces that may cross up to a given layer.
 #[derive(Debug, Default)]
 pub(super) struct CrossingGuard {
@@ -138,7 +142,7 @@ impl CrossingGuard {
             .pairs
             .par_iter()
             .copied()
-            .chain(pairs_at_changes(plan, reshape, front, suspects).into_par_iter())
+            .chain(pairs_at_changes(plan, reshape, front, columns, suspects).into_par_iter())
             .filter(|&(f, g)| {
                 (suspect[f as usize] || suspect[g as usize]) && boxes[f as usize].overlaps(&boxes[g as usize])
             })
@@ -197,15 +201,23 @@ fn trace_crossing_pairs(front: &Front, columns: &Columns, pairs: impl Iterator<I
 
 /// The pairs of triangles sharing a column but no edge where one of them changes shape this
 /// slab (a column of it stops while another moves, merges, or has a split on its edge), among
-/// the `suspects`. A front moving as a whole cannot fold over a shared vertex without turning a
-/// cell between them inside out; where columns stop at different layers or merge, thin
-/// triangles can, with every cell valid, so these pairs are tested beyond their shared vertex.
+/// the `suspects`, or whose columns point apart by more than [`TURNED`]. A front moving as a
+/// whole cannot fold over a shared vertex without turning a cell between them inside out unless
+/// it turns sharply there (a hole a few edges round, whose fronts meet on its axis: flange); where
+/// columns stop at different layers or merge, thin triangles can, with every cell valid, so these
+/// pairs are tested beyond their shared vertex.
 fn pairs_at_changes(
     plan: &SlabPlan,
     reshape: &Reshape,
     front: &Front,
+    columns: &Columns,
     suspects: &[usize],
 ) -> Vec<(u32, u32)> {
+    let direction = |f: usize| front.face_columns(f).iter().map(|&c| columns.dir[c as usize]).sum::<DVec3>();
+    let turned = |f: usize, g: usize| {
+        let (a, b) = (direction(f), direction(g));
+        a.dot(b) < TURNED * a.length() * b.length()
+    };
     let changes = |f: usize| {
         let cols = front.face_columns(f);
         let moving = |c: u32| plan.moving[plan.merges.root(c) as usize];
@@ -219,14 +231,18 @@ fn pairs_at_changes(
     let mut pairs: Vec<(u32, u32)> = suspects
         .par_iter()
         .copied()
-        .filter(|&f| front.face_columns(f).len() == 3 && changes(f))
+        .filter(|&f| front.face_columns(f).len() == 3)
         .flat_map_iter(|f| {
             let cols = front.face_columns(f);
+            let changed = changes(f);
             cols.iter()
                 .flat_map(move |&c| front.faces_of(c))
                 .filter(move |&g| {
                     let other = front.face_columns(g);
-                    g != f && other.len() == 3 && other.iter().filter(|c| cols.contains(c)).count() == 1
+                    g != f
+                        && other.len() == 3
+                        && other.iter().filter(|c| cols.contains(c)).count() == 1
+                        && (changed || turned(f, g))
                 })
                 .map(move |g| (f.min(g) as u32, f.max(g) as u32))
         })

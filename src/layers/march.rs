@@ -736,6 +736,10 @@ fn repair_invalid_cells(
         }
         if changed.is_empty() && changed_faces.is_empty() {
             for &f in &uncollapsed {
+                // A merge or bend for a face before it in this round may have mended it.
+                if face_cell_is_valid(plan, reshape, mesh, columns, front, f) {
+                    continue;
+                }
                 let invalid_cells = |plan: &SlabPlan, group: &[u32]| {
                     invalid_cells_around(plan, reshape, mesh, columns, front, group)
                 };
