@@ -169,6 +169,18 @@ impl Columns {
         }
         c
     }
+
+    /// The extrusion scale of a column along `dir` that replaces or joins columns `a` and `b`
+    /// (a split between them, or their merge in the middle): each one's step projected on `dir`
+    /// (what the offset of the walls under it gains along `dir`), their mean, and at least 1.
+    /// Between the two corners of a concave ridge end (scale `sqrt 3`, directions 70 deg apart)
+    /// it is the ridge's `sqrt 2`, where the mean of their scales ran the column along the
+    /// ridge's bisector 23% ahead of the walls' offset (a fin's trailing edge at a body); across
+    /// a convex fan (scales 1) it stays 1.
+    pub fn scale_along(&self, a: usize, b: usize, dir: DVec3) -> f64 {
+        let projected = |c: usize| self.scale[c] * self.dir[c].dot(dir);
+        (0.5 * (projected(a) + projected(b))).max(1.0)
+    }
 }
 
 /// The front: triangles and quads of columns, oriented with their normal into the fluid.
@@ -403,4 +415,38 @@ pub fn initial_front(surface: &Surface, normals: &WallNormals) -> (Columns, Fron
     }
     front.index_columns(columns.len());
     (columns, front)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::f64::consts::SQRT_2;
+
+    fn columns(ends: [(DVec3, f64); 2]) -> Columns {
+        Columns {
+            dir: ends.map(|e| e.0.normalize()).to_vec(),
+            scale: ends.map(|e| e.1).to_vec(),
+            ..Default::default()
+        }
+    }
+
+    /// A column between the two corners of a concave 90-degree ridge end (three walls,
+    /// directions `(1, +-1, -1) / sqrt 3`, scale `sqrt 3`) runs along the ridge's bisector at the
+    /// ridge's scale `sqrt 2`, so its top stays at the walls' distance; one between a face
+    /// column and a ridge column gets what the face's offset plane asks (`1 / cos 22.5 deg`)
+    /// within 3.1% (the mean of the scales was 11.5% over); across a convex fan (scales 1) it
+    /// keeps 1.
+    #[test]
+    fn a_column_between_two_moves_at_the_speed_of_the_walls_under_it() {
+        let corners =
+            columns([(DVec3::new(1.0, 1.0, -1.0), 3f64.sqrt()), (DVec3::new(1.0, -1.0, -1.0), 3f64.sqrt())]);
+        let bisector = DVec3::new(1.0, 0.0, -1.0).normalize();
+        assert!((corners.scale_along(0, 1, bisector) - SQRT_2).abs() < 1e-12);
+        let face_and_ridge = columns([(DVec3::X, 1.0), (DVec3::new(1.0, 1.0, 0.0), SQRT_2)]);
+        let dir = (face_and_ridge.dir[0] + face_and_ridge.dir[1]).normalize();
+        let (exact, scale) = (1.0 / dir.dot(DVec3::X), face_and_ridge.scale_along(0, 1, dir));
+        assert!(scale >= exact && scale < 1.035 * exact, "{scale} against {exact}");
+        let fan = columns([(DVec3::X, 1.0), (DVec3::Y, 1.0)]);
+        assert_eq!(fan.scale_along(0, 1, (DVec3::X + DVec3::Y).normalize()), 1.0);
+    }
 }

@@ -319,8 +319,8 @@ pub(super) fn propose(
 
 /// The column born at the middle of `edge` in layer `k`: from the middle of the arc between its
 /// ends' wall points (the wall vertex itself for a fan edge), along their mean direction at the
-/// scale [`split_scale`] gives, its top the middle of theirs pushed along that direction onto the
-/// layer's distance (by at least [`SPLIT_LIFT`] of the layer).
+/// scale [`Columns::scale_along`] gives, its top the middle of theirs pushed along that
+/// direction onto the layer's distance (by at least [`SPLIT_LIFT`] of the layer).
 /// `None` where the ends slide differently or point opposite ways.
 fn new_column(
     columns: &Columns,
@@ -333,7 +333,7 @@ fn new_column(
         return None;
     }
     let dir = (columns.dir[a] + columns.dir[b]).try_normalize()?;
-    let scale = split_scale([(columns.dir[a], columns.scale[a]), (columns.dir[b], columns.scale[b])], dir);
+    let scale = columns.scale_along(a, b, dir);
     let (p, q) = (columns.base[a], columns.base[b]);
     let base = 0.5 * (p + q) + dir * arc_rise(p, columns.dir[a], q, columns.dir[b]);
     let d = columns.distance(a, k)?;
@@ -344,17 +344,6 @@ fn new_column(
     let push = (scale * d - (middle - base).dot(dir)).max(lift);
     let top = columns.slide[a].project(middle + dir * push);
     Some(((base, dir, scale), top))
-}
-
-/// The extrusion scale of a column along `dir` born between columns with the given directions
-/// and scales: each end's step projected on `dir` (what the offset of the walls under it gains
-/// along `dir`), their mean, and at least 1. Between two corners of a concave ridge (scale
-/// `sqrt 3`, directions 70 deg apart) it is the ridge's `sqrt 2`, where the mean of their scales
-/// ran a fin's trailing-edge column ahead of the front by 23% a layer; across a convex fan
-/// (scales 1) it stays 1, the new top pushed out onto the arc.
-fn split_scale(ends: [(DVec3, f64); 2], dir: DVec3) -> f64 {
-    let projected = ends.iter().map(|&(d, s)| s * d.dot(dir)).sum::<f64>() / 2.0;
-    projected.max(1.0)
 }
 
 /// The cell over a front face whose edge `i` (from corner `i` to `i + 1`) is split with the top
@@ -501,27 +490,6 @@ pub(super) fn commit(
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// A column born between the two corners of a concave 90-degree ridge end (three walls,
-    /// directions `(1, +-1, -1) / sqrt 3`, scale `sqrt 3`) runs along the ridge's bisector at the
-    /// ridge's scale `sqrt 2`, so its top stays at the walls' distance; one between a face
-    /// column and a ridge column gets what the face's offset plane asks (`1 / cos 22.5 deg`)
-    /// within 3.1% (the mean of the scales was 11.5% over); across a convex fan (scales 1) it
-    /// keeps 1.
-    #[test]
-    fn a_split_column_moves_at_the_speed_of_the_walls_under_it() {
-        let corner = |y: f64| (DVec3::new(1.0, y, -1.0).normalize(), 3f64.sqrt());
-        let (a, b) = (corner(1.0), corner(-1.0));
-        let dir = (a.0 + b.0).normalize();
-        assert!((split_scale([a, b], dir) - SQRT_2).abs() < 1e-12);
-        let (face, ridge) = ((DVec3::X, 1.0), (DVec3::new(1.0, 1.0, 0.0).normalize(), SQRT_2));
-        let dir = (face.0 + ridge.0).normalize();
-        let exact = 1.0 / dir.dot(DVec3::X);
-        let scale = split_scale([face, ridge], dir);
-        assert!(scale >= exact && scale < 1.035 * exact, "{scale} against {exact}");
-        let fan = [(DVec3::X, 1.0), (DVec3::Y, 1.0)];
-        assert_eq!(split_scale(fan, (DVec3::X + DVec3::Y).normalize()), 1.0);
-    }
 
     /// A front edge as long as on the wall (0.3, not compressed) is kept under a thin layer,
     /// collapsed under one 1.67 high (the ONERA M6's wing tip), but kept where the user asks
