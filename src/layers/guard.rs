@@ -118,11 +118,11 @@ impl CrossingGuard {
         self.rebuilds += 1;
     }
 
-    /// The faces of the proposed front that cross another face of it, its quads taken with the
+    /// The pairs of faces of the proposed front that cross each other, its quads taken with the
     /// pyramid the core fill will cap them with; and the quads that no pyramid can cap.
     /// Only pairs with a face among `suspects` (the faces whose top moved since the last test)
     /// are tested.
-    pub fn crossing_faces(
+    pub fn crossings(
         &self,
         plan: &SlabPlan,
         reshape: &Reshape,
@@ -130,7 +130,7 @@ impl CrossingGuard {
         columns: &Columns,
         front: &Front,
         suspects: &[usize],
-    ) -> Vec<usize> {
+    ) -> Crossings {
         let mut suspect = vec![false; front.len()];
         for &f in suspects {
             suspect[f] = true;
@@ -161,17 +161,39 @@ impl CrossingGuard {
             let crossing = tested.iter().copied().filter(|&(f, g)| shape(f).crosses(shape(g)));
             trace_crossing_pairs(front, columns, crossing);
         }
-        let mut faces: Vec<usize> = tested
+        let mut pairs: Vec<(usize, usize)> = tested
             .par_iter()
             .filter(|&&(f, g)| shape(f).crosses(shape(g)))
-            .flat_map_iter(|&(f, g)| [f as usize, g as usize])
+            .map(|&(f, g)| (f as usize, g as usize))
             .collect();
-        let uncappable = |f: usize| front.face_columns(f).len() == 4 && top.shape(f).uncappable;
-        faces.par_extend(suspects.par_iter().copied().filter(|&f| uncappable(f)));
-        faces.sort_unstable();
-        faces.dedup();
-        faces
+        pairs.sort_unstable();
+        pairs.dedup();
+        let cappable = |f: usize| front.face_columns(f).len() != 4 || !top.shape(f).uncappable;
+        let uncappable = suspects.par_iter().copied().filter(|&f| !cappable(f)).collect();
+        Crossings { pairs, uncappable }
     }
+
+    /// Whether the proposed tops of faces `f` and `g` cross (as in [`CrossingGuard::crossings`]).
+    #[allow(clippy::too_many_arguments)]
+    pub fn pair_crosses(
+        plan: &SlabPlan,
+        reshape: &Reshape,
+        mesh: &VolumeMesh,
+        columns: &Columns,
+        front: &Front,
+        f: usize,
+        g: usize,
+    ) -> bool {
+        let top = TopFront { plan, reshape, mesh, columns, front };
+        top.shape(f).crosses(&top.shape(g))
+    }
+}
+
+/// What the crossing guard found: pairs of faces whose tops cross, and quads no pyramid caps.
+#[derive(Debug, Default)]
+pub struct Crossings {
+    pub pairs: Vec<(usize, usize)>,
+    pub uncappable: Vec<usize>,
 }
 
 /// Log every crossing pair with how near the two faces are on the front (columns shared; a
@@ -479,21 +501,15 @@ mod tests {
                     Reach { end, through_layer: k + LOOKAHEAD_LAYERS - 1 },
                 );
             }
-            crossings.push(guard.crossing_faces(
-                &plan,
-                &Reshape::default(),
-                &mesh,
-                &columns,
-                &front,
-                &[0, 1],
-            ));
+            let found = guard.crossings(&plan, &Reshape::default(), &mesh, &columns, &front, &[0, 1]);
+            crossings.push(found.pairs);
             for (c, p) in proposed.into_iter().enumerate() {
                 columns.node[c] = mesh.points.len() as u32;
                 mesh.points.push(p);
             }
         }
         assert_eq!(guard.rebuilds, 1);
-        assert_eq!(crossings, vec![vec![], vec![], vec![0, 1]]);
+        assert_eq!(crossings, vec![vec![], vec![], vec![(0, 1)]]);
     }
 
     /// Triangles sharing a vertex meet beyond it only when one runs through the other; sharing an

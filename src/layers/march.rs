@@ -629,10 +629,13 @@ fn settle_slab(
         if guard.is_stale(k, &plan) {
             guard.rebuild(&plan, reshape, mesh, columns, front, reach(&plan, mesh, columns, k));
         }
-        let crossing = guard.crossing_faces(&plan, reshape, mesh, columns, front, &suspects);
+        let crossings = guard.crossings(&plan, reshape, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
-        for f in crossing {
-            tracing::debug!(face = f, at = ?wall_points(front, f, columns), "the new front crosses itself: stopping the face's columns");
+        for (f, g) in crossings.pairs {
+            changed.extend(stop_to_uncross(&mut plan, reshape, mesh, columns, front, f, g));
+        }
+        for f in crossings.uncappable {
+            tracing::debug!(face = f, at = ?wall_points(front, f, columns), "no pyramid caps the quad: stopping its columns");
             changed.extend(plan.stop_all(front.face_columns(f).iter().copied()));
         }
         if changed.is_empty() {
@@ -641,6 +644,27 @@ fn settle_slab(
         to_check = front.faces_around_columns(&changed);
         suspects = to_check.clone();
     }
+}
+
+/// Stop the columns of the crossing faces `f` and `g`, unless an earlier stop uncrossed them
+/// (fronts meeting head on across a gap both stop, at the medial surface). Returns the columns
+/// that stopped.
+fn stop_to_uncross(
+    plan: &mut SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    f: usize,
+    g: usize,
+) -> Vec<u32> {
+    if !CrossingGuard::pair_crosses(plan, reshape, mesh, columns, front, f, g) {
+        return Vec::new();
+    }
+    tracing::debug!(face = f, other = g, at = ?wall_points(front, f, columns), "the new front crosses itself: stopping both faces' columns");
+    let mut stopped = plan.stop_all(front.face_columns(f).iter().copied());
+    stopped.extend(plan.stop_all(front.face_columns(g).iter().copied()));
+    stopped
 }
 
 /// How many cells around the columns `group` are invalid under `plan`.
