@@ -170,10 +170,9 @@ impl Columns {
         c
     }
 
-    /// The extrusion scale of a column along `dir` that replaces or joins columns `a` and `b`
-    /// (a split between them, or their merge in the middle): each one's step projected on `dir`
-    /// (what the offset of the walls under it gains along `dir`), their mean, and at least 1.
-    /// Between the two corners of a concave ridge end (scale `sqrt 3`, directions 70 deg apart)
+    /// The extrusion scale of a column along `dir` born between columns `a` and `b` (a split
+    /// of their edge): each one's step projected on `dir` (what the offset of the walls under
+    /// it gains along `dir`), their mean, and at least 1. Between the two corners of a concave ridge end (scale `sqrt 3`, directions 70 deg apart)
     /// it is the ridge's `sqrt 2`, where the mean of their scales ran the column along the
     /// ridge's bisector 23% ahead of the walls' offset (a fin's trailing edge at a body); across
     /// a convex fan (scales 1) it stays 1.

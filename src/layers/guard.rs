@@ -191,7 +191,7 @@ impl CrossingGuard {
 
 /// What the crossing guard found: pairs of faces whose tops cross, and quads no pyramid caps.
 #[derive(Debug, Default)]
-pub struct Crossings {
+pub(super) struct Crossings {
     pub pairs: Vec<(usize, usize)>,
     pub uncappable: Vec<usize>,
 }
