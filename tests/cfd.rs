@@ -198,3 +198,15 @@ fn onera_m6_half_wing_with_layers_to_isotropy() {
     let out = mesh(&surface, config, true);
     assert!(out.report.core.is_some());
 }
+
+/// The elbow as an external body with 5 layers from 2e-3 of its diagonal at growth 1.15: two
+/// front faces end on one triangle with opposite orientations (the cells under them meet
+/// there). Kept as front, that doubled triangle made the core fill refuse its boundary as
+/// self-intersecting; it is an interior face, and the mesh is whole and valid.
+#[test]
+fn a_front_closing_on_itself_is_no_boundary_for_the_core() {
+    let surface = read_surface(std::path::Path::new(ELBOW)).expect("the elbow reads");
+    let h0 = 2e-3 * surface.bounding_box().diagonal();
+    let out = mesh(&surface, &format!("[layers]\ncount = 5\nfirst_height = {h0}\ngrowth = 1.15\n"), true);
+    assert!(out.report.core.is_some(), "a core");
+}

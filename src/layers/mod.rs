@@ -256,16 +256,13 @@ fn add_boundary(mesh: &mut VolumeMesh, surface: &Surface, front: &front::Front, 
             mesh.boundary.triangle_patch.push(surface.triangle_patch[t]);
         }
     }
-    for f in 0..front.len() {
-        if !front.raised[f] {
-            continue;
-        }
-        match top_polygon(front, columns, f).as_ref().map(|p| p.nodes()) {
-            Some(&[a, b, c]) => {
+    for top in front_tops(front, columns, (0..front.len()).filter(|&f| front.raised[f])) {
+        match *top.nodes() {
+            [a, b, c] => {
                 mesh.boundary.triangles.push([a, b, c]);
                 mesh.boundary.triangle_patch.push(top_patch);
             }
-            Some(&[a, b, c, d]) => {
+            [a, b, c, d] => {
                 mesh.boundary.quads.push([a, b, c, d]);
                 mesh.boundary.quad_patch.push(top_patch);
             }
@@ -274,9 +271,62 @@ fn add_boundary(mesh: &mut VolumeMesh, surface: &Surface, front: &front::Front, 
     }
 }
 
+/// The tops of front faces `faces` where the columns are now, but for the pairs that are one
+/// polygon with opposite orientations: the two cells under such a pair meet there (a front
+/// closing on itself over a collapsed edge, the elbow's outlet plane), so it is no front; kept,
+/// the core would see a doubled boundary face.
+fn front_tops(
+    front: &front::Front,
+    columns: &front::Columns,
+    faces: impl Iterator<Item = usize>,
+) -> Vec<slab::Polygon> {
+    let tops: Vec<slab::Polygon> = faces.filter_map(|f| top_polygon(front, columns, f)).collect();
+    let mut by_nodes: std::collections::HashMap<Vec<u32>, Vec<usize>> = std::collections::HashMap::new();
+    for (i, top) in tops.iter().enumerate() {
+        let mut key = top.nodes().to_vec();
+        key.sort_unstable();
+        by_nodes.entry(key).or_default().push(i);
+    }
+    let mut keep = vec![true; tops.len()];
+    for same in by_nodes.values().filter(|v| v.len() > 1) {
+        for (n, &i) in same.iter().enumerate() {
+            if let Some(&j) =
+                same[n + 1..].iter().find(|&&j| keep[i] && keep[j] && tops[j].is_reverse_of(&tops[i]))
+            {
+                keep[i] = false;
+                keep[j] = false;
+            }
+        }
+    }
+    tops.into_iter().zip(keep).filter_map(|(top, k)| k.then_some(top)).collect()
+}
+
 /// The top of front face `f` where the columns are now: its distinct nodes (a triangle or a
 /// quad; `None` when merges left fewer than three).
 fn top_polygon(front: &front::Front, columns: &front::Columns, f: usize) -> Option<slab::Polygon> {
     let nodes: Vec<u32> = front.face_columns(f).iter().map(|&c| columns.node[c as usize]).collect();
     slab::Polygon::dedup(&nodes)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use glam::DVec3;
+
+    /// Two front faces whose tops became one triangle with opposite orientations (the cells
+    /// under them meet there) are no front: both go, a third face stays, and so does a top that
+    /// is the same triangle with the same orientation (a fold, for the checks to find).
+    #[test]
+    fn a_top_doubled_with_opposite_orientations_is_no_front() {
+        let points: Vec<DVec3> = (0..5).map(|i| DVec3::new(i as f64, (i * i) as f64, 0.0)).collect();
+        let columns = front::Columns::rising(&points, None);
+        let mut front = front::Front::default();
+        for face in [[0, 1, 2], [2, 1, 0], [1, 3, 4], [3, 4, 1]] {
+            front.push(&face, 0, None);
+        }
+        front.index_columns(columns.len());
+        let tops: Vec<Vec<u32>> =
+            front_tops(&front, &columns, 0..front.len()).iter().map(|p| p.nodes().to_vec()).collect();
+        assert_eq!(tops, vec![vec![1, 3, 4], vec![3, 4, 1]]);
+    }
 }

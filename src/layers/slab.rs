@@ -63,6 +63,11 @@ impl Polygon {
         p
     }
 
+    /// Whether `other` is this polygon with the opposite orientation.
+    pub fn is_reverse_of(&self, other: &Polygon) -> bool {
+        self.same_cycle(&other.reversed())
+    }
+
     /// The same nodes in the same cyclic order (whatever the first one).
     fn same_cycle(&self, other: &Polygon) -> bool {
         let (a, b) = (self.nodes(), other.nodes());
@@ -151,8 +156,7 @@ pub fn push_lateral(faces: &mut Vec<Polygon>, quad: [u32; 4], cut: Option<bool>)
 pub fn remove_opposite_pairs(faces: &mut Vec<Polygon>) {
     let mut i = 0;
     while i < faces.len() {
-        let reversed = faces[i].reversed();
-        match (i + 1..faces.len()).find(|&j| faces[j].same_cycle(&reversed)) {
+        match (i + 1..faces.len()).find(|&j| faces[j].is_reverse_of(&faces[i])) {
             Some(j) => {
                 faces.remove(j);
                 faces.remove(i);

@@ -235,10 +235,10 @@ pub fn unfold_front(
 fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]>) {
     let mut triangles = Vec::new();
     let mut quads = Vec::new();
-    for f in 0..front.len() {
-        match super::top_polygon(front, columns, f).as_ref().map(|p| p.nodes()) {
-            Some(&[a, b, c]) => triangles.push([a, b, c]),
-            Some(&[a, b, c, d]) => quads.push([a, b, c, d]),
+    for top in super::front_tops(front, columns, 0..front.len()) {
+        match *top.nodes() {
+            [a, b, c] => triangles.push([a, b, c]),
+            [a, b, c, d] => quads.push([a, b, c, d]),
             _ => {}
         }
     }
