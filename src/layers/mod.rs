@@ -273,8 +273,8 @@ fn add_boundary(mesh: &mut VolumeMesh, surface: &Surface, front: &front::Front, 
 
 /// The tops of front faces `faces` where the columns are now, but for the pairs that are one
 /// polygon with opposite orientations: the two cells under such a pair meet there (a front
-/// closing on itself over a collapsed edge, the elbow's outlet plane), so it is no front; kept,
-/// the core would see a doubled boundary face.
+/// closing on itself over a collapsed edge: the elbow with 5 layers at r = 1.15), so it is no
+/// front; kept, the core would see a doubled boundary face.
 fn front_tops(
     front: &front::Front,
     columns: &front::Columns,
