@@ -61,6 +61,78 @@ pub(super) fn bend_to_mend(
     None
 }
 
+/// How far a top is tipped sideways to mend a cell, as a fraction of its step, tried in order.
+const NUDGES: [f64; 4] = [0.1, 0.2, 0.35, 0.5];
+
+/// Tip one moving root of invalid face `f` sideways (its step keeps its length; eight ways round
+/// its direction, the least tip first) so that `f`'s cell is valid and fewer cells around the
+/// root are invalid; returns the root. The last repair before stopping columns, for cells that
+/// no merge and no bend to the neighbours' mean mends: where fronts from several walls meet in
+/// a corner the mean direction of a column's neighbours (fans, bisectors) says little, but a
+/// small turn of the merged column's top often unfolds the cell (the arrow's fin trailing
+/// edges, where fin, trailing edge and body fronts meet). Fan columns are tipped too: the
+/// cells around them are tested alike.
+pub(super) fn nudge_to_mend(
+    plan: &mut SlabPlan,
+    front: &Front,
+    f: usize,
+    columns: &Columns,
+    points: &[DVec3],
+    face_valid: &impl Fn(&SlabPlan) -> bool,
+    invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
+) -> Option<u32> {
+    for r in plan.merges.face_roots(front, f) {
+        if !plan.moving[r as usize] {
+            continue;
+        }
+        let c = r as usize;
+        let group: Vec<u32> = plan.merges.group(r).collect();
+        let before = invalid_cells(plan, &group);
+        let saved = plan.proposed[c];
+        let node = points[columns.node[c] as usize];
+        let step = saved - node;
+        let along = step.normalize_or_zero();
+        // The direction it marches on in: a column tipped before in this slab goes on from there.
+        let (dir, scale) = plan
+            .redirected
+            .iter()
+            .rev()
+            .find(|e| e.0 == r)
+            .map_or((columns.dir[c], columns.scale[c]), |e| (e.1, e.2));
+        if along == DVec3::ZERO {
+            continue;
+        }
+        let (e1, e2) = along.any_orthonormal_pair();
+        for t in NUDGES {
+            let mut best: Option<(usize, DVec3)> = None;
+            for i in 0..8 {
+                let a = i as f64 * std::f64::consts::FRAC_PI_4;
+                let side = t * (a.cos() * e1 + a.sin() * e2);
+                plan.proposed[c] =
+                    columns.slide[c].project(node + (along + side).normalize() * step.length());
+                if !face_valid(plan) {
+                    continue;
+                }
+                let left = invalid_cells(plan, &group);
+                if left < before && best.is_none_or(|(b, _)| left < b) {
+                    best = Some((left, side));
+                }
+            }
+            plan.proposed[c] = saved;
+            if let Some((_, side)) = best {
+                let tipped = (along + side).normalize();
+                plan.proposed[c] = columns.slide[c].project(node + tipped * step.length());
+                let turn = glam::DQuat::from_rotation_arc(along, tipped);
+                plan.redirected.push((r, (turn * dir).normalize(), scale));
+                plan.tips += 1;
+                tracing::debug!(f, r, t, at = ?columns.base[c], "invalid cell mended by tipping a column");
+                return Some(r);
+            }
+        }
+    }
+    None
+}
+
 /// Whether column `c` is joined to another by a fan edge.
 fn in_a_fan(front: &Front, columns: &Columns, c: u32) -> bool {
     let mut mates = Vec::new();
@@ -138,5 +210,53 @@ mod tests {
         let bent = bend_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid);
         assert_ne!(bent, Some(0));
         assert_eq!(plan.proposed[0], before[0]);
+    }
+
+    #[test]
+    fn a_fan_column_bend_leaves_alone_is_tipped_back_until_its_cells_stand() {
+        let (mut columns, front, bottoms, mut plan) = leaning_centre();
+        columns.base[1] = columns.base[0];
+        let invalid = |plan: &SlabPlan, group: &[u32]| {
+            let faces = front.faces_around_columns(group);
+            faces.into_iter().filter(|&f| !top_faces_up(plan, &front, f)).count()
+        };
+        let face_valid = |plan: &SlabPlan| top_faces_up(plan, &front, 0);
+        assert_eq!(bend_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid), None);
+        // Each tip leaves fewer cells inverted; the march tips again while one is left.
+        let mut tips = 0;
+        while invalid(&plan, &[0]) > 0 {
+            let before = invalid(&plan, &[0]);
+            assert_eq!(
+                nudge_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid),
+                Some(0)
+            );
+            assert!(invalid(&plan, &[0]) < before);
+            tips += 1;
+        }
+        assert!(tips <= 2, "{tips} tips");
+        assert!((plan.proposed[0].length() - 1.2).abs() < 1e-12, "the step keeps its length");
+        let &(c, dir, _) = plan.redirected.last().unwrap();
+        assert_eq!(c, 0);
+        let step_dir = plan.proposed[0].normalize();
+        assert!(dir.angle_between(step_dir) < 1e-9, "it marches on along its tipped step");
+        let tip = dir.angle_between(columns.dir[0]).to_degrees();
+        assert!(tip > 0.0 && tip <= tips as f64 * 0.5f64.atan().to_degrees() + 1e-9, "tipped {tip} deg");
+        assert!(plan.proposed[0].z > 1.2 * columns.dir[0].z, "tipped up, back over its ring");
+    }
+
+    #[test]
+    fn a_cell_no_tip_mends_leaves_the_plan_as_it_was() {
+        let (columns, front, bottoms, mut plan) = leaning_centre();
+        // Far out past the ring and nearly flat: half a step sideways cannot bring it back.
+        plan.proposed[0] = 3.0 * DVec3::new(1.0, 0.0, 0.05).normalize();
+        let before = plan.proposed.clone();
+        let invalid = |plan: &SlabPlan, group: &[u32]| {
+            let faces = front.faces_around_columns(group);
+            faces.into_iter().filter(|&f| !top_faces_up(plan, &front, f)).count()
+        };
+        let face_valid = |plan: &SlabPlan| top_faces_up(plan, &front, 0);
+        assert_eq!(nudge_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid), None);
+        assert_eq!(plan.proposed, before);
+        assert!(plan.redirected.is_empty());
     }
 }

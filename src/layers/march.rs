@@ -49,6 +49,8 @@ pub struct MarchStats {
     /// Columns turned towards their neighbours' direction to mend an invalid cell, instead of
     /// stopping.
     pub bent_columns: usize,
+    /// Columns whose top tipped sideways to mend an invalid cell, instead of stopping.
+    pub tipped_columns: usize,
     /// Long front edges left unsplit for a layer because the split would have made an invalid
     /// cell.
     pub splits_given_up: usize,
@@ -149,6 +151,8 @@ pub(super) struct SlabPlan {
     pub flat_tops: usize,
     /// Columns bent to mend an invalid cell ([`bend::bend_to_mend`]).
     pub bends: usize,
+    /// Columns tipped to mend an invalid cell ([`bend::nudge_to_mend`]).
+    pub tips: usize,
 }
 
 impl SlabPlan {
@@ -164,6 +168,7 @@ impl SlabPlan {
             coarsened: 0,
             flat_tops: 0,
             bends: 0,
+            tips: 0,
         }
     }
 
@@ -424,6 +429,7 @@ pub fn march(
         stats.tangential_collapses += plan.coarsened;
         stats.flat_top_collapses += plan.flat_tops;
         stats.bent_columns += plan.bends;
+        stats.tipped_columns += plan.tips;
         let (split_count, swap_count) =
             commit_slab(mesh, columns, front, &plan, &reshape, sizes, k, &mut stats);
         stats.splits += split_count;
@@ -719,8 +725,10 @@ fn mend_by_merge(
 }
 
 /// Check the cells over `to_check` and repair the invalid ones until every cell is valid: giving
-/// up their swap or splits, else merges that mend them ([`mend_by_merge`]), else stopping the
-/// fewest of their columns ([`stop_fewest_columns`]) or all of them.
+/// up their swap or splits, else merges that mend them ([`mend_by_merge`]), else a column bent
+/// to its neighbours ([`bend::bend_to_mend`]) or its top tipped sideways
+/// ([`bend::nudge_to_mend`]), else stopping the fewest of their columns
+/// ([`stop_fewest_columns`]) or all of them.
 /// Merges come first: an invalid cell without a crushed edge of its own may be mended by a
 /// collapse next to it (its neighbour crosses the bisector in another cell), so its columns stop
 /// only after a round that merged nothing. Returns the faces whose cells changed.
@@ -774,6 +782,12 @@ fn repair_invalid_cells(
                 let face_valid = |plan: &SlabPlan| face_cell_is_valid(plan, reshape, mesh, columns, front, f);
                 if let Some(root) =
                     bend::bend_to_mend(plan, front, f, columns, &mesh.points, &face_valid, &invalid_cells)
+                {
+                    changed.extend(plan.merges.group(root));
+                    continue;
+                }
+                if let Some(root) =
+                    bend::nudge_to_mend(plan, front, f, columns, &mesh.points, &face_valid, &invalid_cells)
                 {
                     changed.extend(plan.merges.group(root));
                     continue;
