@@ -70,8 +70,8 @@ const NUDGES: [f64; 4] = [0.1, 0.2, 0.35, 0.5];
 /// no merge and no bend to the neighbours' mean mends: where fronts from several walls meet in
 /// a corner the mean direction of a column's neighbours (fans, bisectors) says little, but a
 /// small turn of the merged column's top often unfolds the cell (the arrow's fin trailing
-/// edges, where fin, trailing edge and body fronts meet). Fan columns are tipped too: the
-/// cells around them are tested alike.
+/// edges, where fin, trailing edge and body fronts meet). Fan columns are tipped too (the
+/// cells around them are tested alike), though not everywhere ([`may_tip`]).
 pub(super) fn nudge_to_mend(
     plan: &mut SlabPlan,
     front: &Front,
@@ -82,10 +82,10 @@ pub(super) fn nudge_to_mend(
     invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
 ) -> Option<u32> {
     for r in plan.merges.face_roots(front, f) {
-        if !plan.moving[r as usize] {
+        let c = r as usize;
+        if !plan.moving[c] || !may_tip(front, columns, c) {
             continue;
         }
-        let c = r as usize;
         let group: Vec<u32> = plan.merges.group(r).collect();
         let before = invalid_cells(plan, &group);
         let saved = plan.proposed[c];
@@ -133,6 +133,16 @@ pub(super) fn nudge_to_mend(
     None
 }
 
+/// Whether column `c` may be tipped: within its full stack (a stop in the transition layers
+/// above costs no coverage, and there the tips roughen the front the core fills: bunny, 20
+/// layers, 19 -> 55 tetrahedra below 10 deg), and a fan's column not in its first layer (a
+/// fan's cells start as wedges on the wall edge; tipped there, the bunny's fans at a corner
+/// went on a few layers and stopped one by one: 96).
+fn may_tip(front: &Front, columns: &Columns, c: usize) -> bool {
+    let within_stack = columns.full_count(c).is_some_and(|n| columns.layers[c] < n);
+    within_stack && (columns.layers[c] > 0 || !in_a_fan(front, columns, c as u32))
+}
+
 /// Whether column `c` is joined to another by a fan edge.
 fn in_a_fan(front: &Front, columns: &Columns, c: u32) -> bool {
     let mut mates = Vec::new();
@@ -151,6 +161,7 @@ fn neighbour_direction(plan: &SlabPlan, front: &Front, columns: &Columns, r: u32
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::config::LayerSpec;
 
     /// Column 0 at the centre of a hexagon of columns 1-6 on the plane z = 0, in triangles
     /// (0, i, i + 1); the ring rises 0.5 up +z, column 0 leans along +x past the ring's column 1.
@@ -160,7 +171,7 @@ mod tests {
             DVec3::new(a.cos(), a.sin(), 0.0)
         });
         let bottoms: Vec<DVec3> = std::iter::once(DVec3::ZERO).chain(ring).collect();
-        let mut columns = Columns::rising(&bottoms, None);
+        let mut columns = Columns::rising(&bottoms, Some(LayerSpec::fixed(0.1, 1.2, 10)));
         columns.dir[0] = DVec3::new(0.9, 0.0, 0.44).normalize();
         let mut front = Front::default();
         for i in 1..=6u32 {
@@ -216,6 +227,7 @@ mod tests {
     fn a_fan_column_bend_leaves_alone_is_tipped_back_until_its_cells_stand() {
         let (mut columns, front, bottoms, mut plan) = leaning_centre();
         columns.base[1] = columns.base[0];
+        columns.layers[0] = 3;
         let invalid = |plan: &SlabPlan, group: &[u32]| {
             let faces = front.faces_around_columns(group);
             faces.into_iter().filter(|&f| !top_faces_up(plan, &front, f)).count()
@@ -258,5 +270,25 @@ mod tests {
         assert_eq!(nudge_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid), None);
         assert_eq!(plan.proposed, before);
         assert!(plan.redirected.is_empty());
+    }
+
+    #[test]
+    fn no_column_is_tipped_above_its_full_stack_nor_a_fan_in_its_first_layer() {
+        let (mut columns, front, bottoms, mut plan) = leaning_centre();
+        let invalid = |plan: &SlabPlan, group: &[u32]| {
+            let faces = front.faces_around_columns(group);
+            faces.into_iter().filter(|&f| !top_faces_up(plan, &front, f)).count()
+        };
+        let face_valid = |plan: &SlabPlan| top_faces_up(plan, &front, 0);
+        // Every column in its 11th layer of 10: transition layers.
+        columns.layers.iter_mut().for_each(|l| *l = 10);
+        assert_eq!(nudge_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid), None);
+        // In its first layer, as a fan's column.
+        columns.layers.iter_mut().for_each(|l| *l = 0);
+        columns.base[1] = columns.base[0];
+        assert_eq!(nudge_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid), None);
+        // In its first layer, alone: tipped.
+        columns.base[1] = bottoms[1];
+        assert_eq!(nudge_to_mend(&mut plan, &front, 0, &columns, &bottoms, &face_valid, &invalid), Some(0));
     }
 }
