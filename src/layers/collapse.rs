@@ -78,6 +78,18 @@ impl Merges {
         released
     }
 
+    /// Take column `c` out of the group it merged into (it is its own root again; the columns
+    /// merged into it before stay with the group's root). `false` when `c` is a root.
+    pub fn detach(&mut self, c: u32) -> bool {
+        let r = self.root[c as usize];
+        if r == c {
+            return false;
+        }
+        self.members[r as usize].retain(|&m| m != c);
+        self.root[c as usize] = c;
+        true
+    }
+
     /// The distinct roots of face `f`'s columns, sorted (two or one where the face is down to an
     /// edge or a point).
     pub fn face_roots(&self, front: &Front, f: usize) -> Vec<u32> {
@@ -207,5 +219,20 @@ mod tests {
         assert_eq!((m.root(1), m.root(2), m.root(3)), (1, 0, 1));
         assert_eq!(m.group(0).collect::<Vec<_>>(), vec![0, 2]);
         assert_eq!(m.group(1).collect::<Vec<_>>(), vec![1, 3]);
+    }
+
+    #[test]
+    fn a_detached_column_leaves_its_group_and_the_rest_stays() {
+        let mut m = Merges::new(6);
+        m.merge(1, 3);
+        m.merge(0, 2);
+        m.merge(0, 1);
+        assert_eq!(m.group(0).collect::<Vec<_>>(), vec![0, 2, 1, 3]);
+        assert!(!m.detach(0), "a root has no group to leave");
+        assert!(m.detach(1));
+        assert!(!m.is_merged(1));
+        assert_eq!(m.group(1).collect::<Vec<_>>(), vec![1], "what merged into 1 before stays with 0");
+        assert_eq!((m.root(2), m.root(3)), (0, 0));
+        assert_eq!(m.group(0).collect::<Vec<_>>(), vec![0, 2, 3]);
     }
 }

@@ -200,6 +200,22 @@ impl SlabPlan {
         changed
     }
 
+    /// Stop the columns `cols` where they are, each taken out of the group it merged into (whose
+    /// root marches on; one that is a root stops with its group, [`SlabPlan::stop`]); returns
+    /// the columns whose cells change.
+    fn stop_out_of_groups(&mut self, cols: &[u32]) -> Vec<u32> {
+        let mut stopped = Vec::new();
+        for &c in cols {
+            if self.merges.detach(c) {
+                self.moving[c as usize] = false;
+                stopped.push(c);
+            } else if self.moving[c as usize] {
+                stopped.extend(self.stop(c));
+            }
+        }
+        stopped
+    }
+
     /// Stop the group of `c`'s root: the root and every column merged into it keep their node.
     /// Returns the columns whose cells change.
     fn stop(&mut self, c: u32) -> Vec<u32> {
@@ -845,10 +861,15 @@ fn face_fan_edges(front: &Front, columns: &Columns, f: usize) -> Vec<bool> {
     (0..n).map(|i| columns.is_fan_edge(cols[i] as usize, cols[(i + 1) % n] as usize)).collect()
 }
 
-/// Stop the fewest columns that mend invalid face `f`: one root of it (with its fan mates on a
-/// fan face), if that leaves its cell valid and fewer invalid cells around; the one whose
-/// stop holds the fewest columns. `None` when no single root does. A face whose far corner is
-/// still short of the bisector its other corners merged on needs only that corner stopped.
+/// Stop the fewest wall points that mend invalid face `f`: one root of it (with its fan mates
+/// on a fan face), or on a fan face one fan of it taken out of the groups its columns merged
+/// into ([`SlabPlan::stop_out_of_groups`]), if that leaves its cell valid and fewer invalid
+/// cells around; the one that stops the fewest wall points. `None` when no such stop does. A
+/// face whose far corner is still short of the bisector its other corners merged on needs only
+/// that corner stopped. A fan whose columns merged into different bisector columns (a fin's
+/// trailing edge 0.2 above the body: its fan is swallowed by the fin's root, its trailing
+/// edge's root and the saddle corner between them) needs only that fan stopped, where stopping
+/// a root would stop every column merged into it.
 fn stop_fewest_columns(
     plan: &mut SlabPlan,
     reshape: &Reshape,
@@ -862,26 +883,43 @@ fn stop_fewest_columns(
         return None;
     }
     let fan_face = face_fan_edges(front, columns, f).contains(&true);
-    let mut best: Option<(usize, SlabPlan, Vec<u32>)> = None;
-    for &r in &roots {
-        let mut group = vec![r];
+    let with_mates = |c: u32| {
+        let mut group = vec![c];
         if fan_face {
             add_fan_mates(front, columns, &mut group);
         }
+        group
+    };
+    let mut candidates: Vec<(Vec<u32>, bool)> = roots.iter().map(|&r| (with_mates(r), false)).collect();
+    if fan_face {
+        let merged = front.face_columns(f).iter().filter(|&&c| plan.merges.is_merged(c));
+        candidates.extend(merged.map(|&c| (with_mates(c), true)));
+    }
+    let mut best: Option<(usize, SlabPlan, Vec<u32>)> = None;
+    for (group, out_of_groups) in candidates {
         let around: Vec<u32> = group.iter().flat_map(|&g| plan.merges.group(plan.merges.root(g))).collect();
         let before = invalid_cells_around(plan, reshape, mesh, columns, front, &around);
         let mut trial = plan.clone();
-        let changed = trial.stop_all(group);
+        let changed = if out_of_groups { trial.stop_out_of_groups(&group) } else { trial.stop_all(group) };
+        let stopped = wall_point_count(columns, &changed);
         if face_cell_is_valid(&trial, reshape, mesh, columns, front, f)
-            && invalid_cells_around(&trial, reshape, mesh, columns, front, &changed) < before
-            && best.as_ref().is_none_or(|b| changed.len() < b.0)
+            && invalid_cells_around(&trial, reshape, mesh, columns, front, &around) < before
+            && best.as_ref().is_none_or(|b| stopped < b.0)
         {
-            best = Some((changed.len(), trial, changed));
+            best = Some((stopped, trial, changed));
         }
     }
     let (_, trial, changed) = best?;
     *plan = trial;
     Some(changed)
+}
+
+/// How many wall points the columns `cols` start from (a fan's columns share one).
+fn wall_point_count(columns: &Columns, cols: &[u32]) -> usize {
+    let mut points: Vec<u32> = cols.iter().map(|&c| columns.wall_vertex[c as usize]).collect();
+    points.sort_unstable();
+    points.dedup();
+    points.len()
 }
 
 /// Add to `group` the fan mates of its columns: the columns joined to them by fan edges.
