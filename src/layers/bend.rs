@@ -1,4 +1,4 @@
-//! Bending a column to mend an invalid cell, the repair before stopping columns.
+//! Bending or tipping a column to mend an invalid cell, the repairs before stopping columns.
 //!
 //! Where the front is crumpled (spot's valleys, the arrow's fin roots just ahead of their
 //! trailing edges and at their leading edges), the directions of neighbouring columns can differ
@@ -8,7 +8,9 @@
 //! neighbours (a step of Laplacian smoothing of the direction field, as advancing-layer methods
 //! smooth their normals) often mends the cell; the column keeps its step length and marches on
 //! in its new direction. (It does not mend the ONERA M6 wing-tip cap, faceted 5 times finer
-//! than its first layer: the cells that fail there are fan cells.)
+//! than its first layer: the cells that fail there are fan cells.) Where the bend does not
+//! mend, a small sideways tip of one column's top, tried round its direction, often does
+//! ([`nudge_to_mend`]).
 
 use super::entropy::neighbour_roots;
 use super::front::{Columns, Front};
@@ -92,6 +94,9 @@ pub(super) fn nudge_to_mend(
         let node = points[columns.node[c] as usize];
         let step = saved - node;
         let along = step.normalize_or_zero();
+        if along == DVec3::ZERO {
+            continue;
+        }
         // The direction it marches on in: a column tipped before in this slab goes on from there.
         let (dir, scale) = plan
             .redirected
@@ -99,9 +104,6 @@ pub(super) fn nudge_to_mend(
             .rev()
             .find(|e| e.0 == r)
             .map_or((columns.dir[c], columns.scale[c]), |e| (e.1, e.2));
-        if along == DVec3::ZERO {
-            continue;
-        }
         let (e1, e2) = along.any_orthonormal_pair();
         for t in NUDGES {
             let mut best: Option<(usize, DVec3)> = None;
