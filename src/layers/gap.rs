@@ -38,15 +38,36 @@ pub fn gap_limited(surface: &Surface, columns: &Columns, points: &[DVec3], stopp
     for &v in stopped {
         is_stopped[v as usize] = true;
     }
+    let edges = wall_edges_at(surface, &is_stopped);
     let short: Vec<(usize, bool)> = (0..columns.len())
         .into_par_iter()
         .filter(|&c| is_stopped[columns.wall_vertex[c] as usize] && stopped_early(columns, c))
-        .map(|c| (columns.wall_vertex[c] as usize, reaches_medial_surface(surface, &bvh, columns, points, c)))
+        .map(|c| {
+            let v = columns.wall_vertex[c] as usize;
+            (v, reaches_medial_surface(surface, &bvh, columns, points, c, &edges[v]))
+        })
         .collect();
     for (v, ok) in short {
         limited[v] |= ok;
     }
     limited
+}
+
+/// The directions of the wall edges at every vertex marked in `at` (none elsewhere).
+fn wall_edges_at(surface: &Surface, at: &[bool]) -> Vec<Vec<DVec3>> {
+    let mut edges = vec![Vec::new(); surface.points.len()];
+    for t in &surface.triangles {
+        for i in 0..3 {
+            let v = t[i] as usize;
+            if at[v] {
+                let p = surface.points[v];
+                for j in [1, 2] {
+                    edges[v].push((surface.points[t[(i + j) % 3] as usize] - p).normalize_or_zero());
+                }
+            }
+        }
+    }
+    edges
 }
 
 /// Whether column `c` (or the column it merged into) has fewer layers than its full count.
@@ -57,13 +78,15 @@ fn stopped_early(columns: &Columns, c: usize) -> bool {
         .is_some_and(|t| columns.layers[carrier] < t && columns.isotropic_ratio[carrier].is_nan())
 }
 
-/// Whether the stack of column `c` ends within one layer of the medial surface of a gap.
+/// Whether the stack of column `c` ends within one layer of the medial surface of a gap
+/// (`wall_edges`: the directions of the wall edges at its wall point).
 fn reaches_medial_surface(
     surface: &Surface,
     bvh: &TriangleBvh,
     columns: &Columns,
     points: &[DVec3],
     c: usize,
+    wall_edges: &[DVec3],
 ) -> bool {
     let (base, dir) = (columns.base[c], columns.dir[c]);
     let Some(first) = columns.spec[c].map(|s| s.first_height) else { return false };
@@ -88,21 +111,29 @@ fn reaches_medial_surface(
     let reaches = |layers: f64| rise + columns.scale[carrier] * layers >= 0.5 * across;
     reaches(next)
         || (reaches(next + height(k + 2))
-            && closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across))
+            && closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across, wall_edges))
 }
 
 /// Tilt (degrees) of the rays that probe whether the wall across curves around a column.
 const PROBE_TILT_DEG: f64 = 20.0;
 
+/// How much the probe rays also lean across their tilt (a fraction of it, both ways): at a
+/// bore's mouth the rays tilted along the rim would graze the far rim; leaning into the bore
+/// they hit its wall just inside (the flange's 1 mm bore: 0.035 mm inside).
+const PROBE_LEAN: f64 = 0.05;
+
 /// Whether the wall across a gap (`across` along `dir` from `base`, hits nearer than `skip`
 /// being the column's own wall) curves around the ray in one direction, as in a bore: rays
 /// tilted both ways in that direction hit it sooner than the straight one (a chord of the
-/// bore), where across a flat gap they would hit it later.
+/// bore), where across a flat gap they would hit it later. The directions tried: two square to
+/// each other, and those of the wall edges at the column's wall point (`wall_edges`: at a bore's
+/// mouth, only the rim's direction keeps both rays in the bore; the others take one out).
 fn closes_on_an_axis(
     surface: &Surface,
     bvh: &TriangleBvh,
     (base, dir, skip): (DVec3, DVec3, f64),
     across: f64,
+    wall_edges: &[DVec3],
 ) -> bool {
     let (sin, cos) = PROBE_TILT_DEG.to_radians().sin_cos();
     let u = dir.any_orthonormal_vector();
@@ -110,7 +141,13 @@ fn closes_on_an_axis(
     let sooner = |side: DVec3| {
         hit(side).is_some_and(|(t, tri)| t < across && surface.triangle_normal(tri as usize).dot(dir) < 0.0)
     };
-    [u, dir.cross(u)].into_iter().any(|side| sooner(side) && sooner(-side))
+    let along_edges = wall_edges.iter().map(|&e| (e - e.dot(dir) * dir).normalize_or_zero());
+    let sides: Vec<DVec3> =
+        [u, dir.cross(u)].into_iter().chain(along_edges).filter(|s| *s != DVec3::ZERO).collect();
+    sides.into_iter().any(|side| {
+        let lean = PROBE_LEAN * dir.cross(side);
+        [lean, -lean].into_iter().any(|l| sooner(side + l) && sooner(-side + l))
+    })
 }
 
 #[cfg(test)]
@@ -184,7 +221,7 @@ mod tests {
         assert!(tube.triangle_normal(0).dot(DVec3::new(-1.0, -0.1, 0.0)) > 0.9, "facing the axis");
         let (across, _) = bvh.first_hit(base, dir, 1e-6, |_| false).unwrap();
         assert!((across - 2.0).abs() < 1e-9);
-        assert!(closes_on_an_axis(&tube, &bvh, (base, dir, 1e-6), across));
+        assert!(closes_on_an_axis(&tube, &bvh, (base, dir, 1e-6), across, &[]));
         // Two parallel walls 2 apart: tilted rays hit the far one later.
         let flat = Surface {
             points: vec![
@@ -201,7 +238,26 @@ mod tests {
         };
         let bvh = TriangleBvh::new((0..2).map(|t| flat.triangle_points(t)).collect());
         assert!(flat.triangle_normal(1).dot(dir) < -0.99, "the far wall faces back");
-        assert!(!closes_on_an_axis(&flat, &bvh, (DVec3::ZERO, dir, 1e-6), 2.0));
+        assert!(!closes_on_an_axis(&flat, &bvh, (DVec3::ZERO, dir, 1e-6), 2.0, &[]));
+        // Nor along the wall's own edges.
+        let edges = [DVec3::Y, DVec3::new(0.0, 1.0, 1.0).normalize()];
+        assert!(!closes_on_an_axis(&flat, &bvh, (DVec3::ZERO, dir, 1e-6), 2.0, &edges));
+    }
+
+    #[test]
+    fn a_bore_closes_on_its_axis_at_its_mouth_along_its_rim() {
+        let tube = bore(24);
+        let bvh = TriangleBvh::new((0..tube.triangles.len()).map(|t| tube.triangle_points(t)).collect());
+        // On the rim of the mouth at z = 1, across the mouth.
+        let (v, dir) = (2 * 24, -DVec3::X);
+        let base = tube.points[v];
+        assert_eq!(base, DVec3::new(1.0, 0.0, 1.0));
+        let (across, _) = bvh.first_hit(base, dir, 1e-6, |_| false).unwrap();
+        let mut at = vec![false; tube.points.len()];
+        at[v] = true;
+        let edges = wall_edges_at(&tube, &at);
+        assert!(edges[v].iter().any(|e| e.z.abs() < 1e-12), "an edge along the rim");
+        assert!(closes_on_an_axis(&tube, &bvh, (base, dir, 1e-6), across, &edges[v]));
     }
 
     #[test]
