@@ -15,6 +15,7 @@ use rayon::prelude::*;
 
 use super::front::Columns;
 use crate::geometry::bvh::TriangleBvh;
+use crate::surface::topology::Topology;
 use crate::surface::Surface;
 
 /// Walls whose normals are within this angle of opposite face each other across a gap.
@@ -28,7 +29,13 @@ const OWN_WALL: f64 = 1e-3;
 /// that stopped early is gap-limited; `points` are the layered mesh's points. (The columns of a
 /// fan end together: on the rim of a narrow hole the fan's columns into the hole end at its
 /// axis, and those along the face beside it end with them.)
-pub fn gap_limited(surface: &Surface, columns: &Columns, points: &[DVec3], stopped: &[u32]) -> Vec<bool> {
+pub fn gap_limited(
+    surface: &Surface,
+    topology: &Topology,
+    columns: &Columns,
+    points: &[DVec3],
+    stopped: &[u32],
+) -> Vec<bool> {
     let mut limited = vec![false; surface.points.len()];
     if stopped.is_empty() {
         return limited;
@@ -38,13 +45,13 @@ pub fn gap_limited(surface: &Surface, columns: &Columns, points: &[DVec3], stopp
     for &v in stopped {
         is_stopped[v as usize] = true;
     }
-    let edges = wall_edges_at(surface, &is_stopped);
     let short: Vec<(usize, bool)> = (0..columns.len())
         .into_par_iter()
         .filter(|&c| is_stopped[columns.wall_vertex[c] as usize] && stopped_early(columns, c))
         .map(|c| {
             let v = columns.wall_vertex[c] as usize;
-            (v, reaches_medial_surface(surface, &bvh, columns, points, c, &edges[v]))
+            let edges = wall_edges_at(surface, topology, v as u32);
+            (v, reaches_medial_surface(surface, &bvh, columns, points, c, &edges))
         })
         .collect();
     for (v, ok) in short {
@@ -53,21 +60,11 @@ pub fn gap_limited(surface: &Surface, columns: &Columns, points: &[DVec3], stopp
     limited
 }
 
-/// The directions of the wall edges at every vertex marked in `at` (none elsewhere).
-fn wall_edges_at(surface: &Surface, at: &[bool]) -> Vec<Vec<DVec3>> {
-    let mut edges = vec![Vec::new(); surface.points.len()];
-    for t in &surface.triangles {
-        for i in 0..3 {
-            let v = t[i] as usize;
-            if at[v] {
-                let p = surface.points[v];
-                for j in [1, 2] {
-                    edges[v].push((surface.points[t[(i + j) % 3] as usize] - p).normalize_or_zero());
-                }
-            }
-        }
-    }
-    edges
+/// The directions of the wall edges at vertex `v` (each once per triangle using it).
+fn wall_edges_at(surface: &Surface, topology: &Topology, v: u32) -> Vec<DVec3> {
+    let p = surface.points[v as usize];
+    let corners = topology.vertex_triangles(v).iter().flat_map(|&t| surface.triangles[t as usize]);
+    corners.filter(|&w| w != v).map(|w| (surface.points[w as usize] - p).normalize_or_zero()).collect()
 }
 
 /// Whether column `c` (or the column it merged into) has fewer layers than its full count.
@@ -188,7 +185,7 @@ mod tests {
         });
         let mut points = surface.points.clone();
         points.push(DVec3::new(0.0, 0.0, top));
-        gap_limited(&surface, &columns, &points, &[0])[0]
+        gap_limited(&surface, &Topology::new(&surface), &columns, &points, &[0])[0]
     }
 
     /// The inside of a tube of radius 1 along z (`n` sides, rings at z = -1, 0, 1), its
@@ -253,11 +250,9 @@ mod tests {
         let base = tube.points[v];
         assert_eq!(base, DVec3::new(1.0, 0.0, 1.0));
         let (across, _) = bvh.first_hit(base, dir, 1e-6, |_| false).unwrap();
-        let mut at = vec![false; tube.points.len()];
-        at[v] = true;
-        let edges = wall_edges_at(&tube, &at);
-        assert!(edges[v].iter().any(|e| e.z.abs() < 1e-12), "an edge along the rim");
-        assert!(closes_on_an_axis(&tube, &bvh, (base, dir, 1e-6), across, &edges[v]));
+        let edges = wall_edges_at(&tube, &Topology::new(&tube), v as u32);
+        assert!(edges.iter().any(|e| e.z.abs() < 1e-12), "an edge along the rim");
+        assert!(closes_on_an_axis(&tube, &bvh, (base, dir, 1e-6), across, &edges));
     }
 
     #[test]

@@ -127,7 +127,7 @@ pub fn build_layers(
     }
     stopped_vertices.sort_unstable();
     stopped_vertices.dedup();
-    let limited = gap::gap_limited(surface, &columns, &mesh.points, &stopped_vertices);
+    let limited = gap::gap_limited(surface, topology, &columns, &mesh.points, &stopped_vertices);
     let (gap_limited_vertices, stopped_vertices) =
         stopped_vertices.into_iter().partition(|&v| limited[v as usize]);
     Layers {
