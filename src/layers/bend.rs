@@ -38,29 +38,59 @@ pub(super) fn bend_to_mend(
             continue;
         }
         let Some(mean) = neighbour_direction(plan, front, columns, r) else { continue };
-        let group: Vec<u32> = plan.merges.group(r).collect();
-        let before = invalid_cells(plan, &group);
-        let (saved, redirected) = (plan.proposed[r as usize], plan.redirected.len());
         let c = r as usize;
         let node = points[columns.node[c] as usize];
-        let step = saved.distance(node);
+        let step = plan.proposed[c].distance(node);
         for w in BENDS {
             let dir = columns.dir[c].lerp(mean, w).normalize_or_zero();
             if dir == DVec3::ZERO {
                 continue;
             }
-            plan.proposed[c] = columns.slide[c].project(node + dir * step);
-            if face_valid(plan) && invalid_cells(plan, &group) < before {
-                plan.redirected.push((r, dir, columns.scale[c]));
+            let top = columns.slide[c].project(node + dir * step);
+            if let Some((top, dir)) = best_top(plan, r, [(top, dir)], face_valid, invalid_cells) {
+                move_top(plan, r, top, (dir, columns.scale[c]));
                 plan.bends += 1;
                 tracing::debug!(f, r, w, at = ?columns.base[c], "invalid cell mended by bending a column");
                 return Some(r);
             }
         }
-        plan.proposed[c] = saved;
-        plan.redirected.truncate(redirected);
     }
     None
+}
+
+/// Of the `candidates` for root `r`'s top (each with the direction it would march on in), the
+/// one that leaves the cell tested by `face_valid` valid and the fewest cells around `r`'s
+/// group invalid, fewer than now (the first of equals); `plan` is left as it was.
+fn best_top(
+    plan: &mut SlabPlan,
+    r: u32,
+    candidates: impl IntoIterator<Item = (DVec3, DVec3)>,
+    face_valid: &impl Fn(&SlabPlan) -> bool,
+    invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
+) -> Option<(DVec3, DVec3)> {
+    let c = r as usize;
+    let group: Vec<u32> = plan.merges.group(r).collect();
+    let before = invalid_cells(plan, &group);
+    let saved = plan.proposed[c];
+    let mut best: Option<(usize, (DVec3, DVec3))> = None;
+    for (top, dir) in candidates {
+        plan.proposed[c] = top;
+        if !face_valid(plan) {
+            continue;
+        }
+        let left = invalid_cells(plan, &group);
+        if left < before && best.is_none_or(|(b, _)| left < b) {
+            best = Some((left, (top, dir)));
+        }
+    }
+    plan.proposed[c] = saved;
+    best.map(|(_, chosen)| chosen)
+}
+
+/// Move root `r`'s top to `top`, the column marching on along `(direction, scale)`.
+fn move_top(plan: &mut SlabPlan, r: u32, top: DVec3, (dir, scale): (DVec3, f64)) {
+    plan.proposed[r as usize] = top;
+    plan.redirected.push((r, dir, scale));
 }
 
 /// How far a top is tipped sideways to mend a cell, as a fraction of its step, tried in order.
@@ -88,11 +118,8 @@ pub(super) fn nudge_to_mend(
         if !plan.moving[c] || !may_tip(front, columns, c) {
             continue;
         }
-        let group: Vec<u32> = plan.merges.group(r).collect();
-        let before = invalid_cells(plan, &group);
-        let saved = plan.proposed[c];
         let node = points[columns.node[c] as usize];
-        let step = saved - node;
+        let step = plan.proposed[c] - node;
         let along = step.normalize_or_zero();
         if along == DVec3::ZERO {
             continue;
@@ -106,26 +133,14 @@ pub(super) fn nudge_to_mend(
             .map_or((columns.dir[c], columns.scale[c]), |e| (e.1, e.2));
         let (e1, e2) = along.any_orthonormal_pair();
         for t in NUDGES {
-            let mut best: Option<(usize, DVec3)> = None;
-            for i in 0..8 {
+            let tips = (0..8).map(|i| {
                 let a = i as f64 * std::f64::consts::FRAC_PI_4;
-                let side = t * (a.cos() * e1 + a.sin() * e2);
-                plan.proposed[c] =
-                    columns.slide[c].project(node + (along + side).normalize() * step.length());
-                if !face_valid(plan) {
-                    continue;
-                }
-                let left = invalid_cells(plan, &group);
-                if left < before && best.is_none_or(|(b, _)| left < b) {
-                    best = Some((left, side));
-                }
-            }
-            plan.proposed[c] = saved;
-            if let Some((_, side)) = best {
-                let tipped = (along + side).normalize();
-                plan.proposed[c] = columns.slide[c].project(node + tipped * step.length());
+                let tipped = (along + t * (a.cos() * e1 + a.sin() * e2)).normalize();
                 let turn = glam::DQuat::from_rotation_arc(along, tipped);
-                plan.redirected.push((r, (turn * dir).normalize(), scale));
+                (columns.slide[c].project(node + tipped * step.length()), (turn * dir).normalize())
+            });
+            if let Some((top, dir)) = best_top(plan, r, tips, face_valid, invalid_cells) {
+                move_top(plan, r, top, (dir, scale));
                 plan.tips += 1;
                 tracing::debug!(f, r, t, at = ?columns.base[c], "invalid cell mended by tipping a column");
                 return Some(r);
