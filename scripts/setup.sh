@@ -24,5 +24,6 @@ fi
 if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
-.venv/bin/python -c "import gmsh, meshio, numpy" 2>/dev/null || \
-  .venv/bin/pip install -q gmsh==4.15.2 meshio==5.3.5 numpy
+# scipy: ../shared/bench/measure.py (the README's peer metric) needs it.
+.venv/bin/python -c "import gmsh, meshio, numpy, scipy" 2>/dev/null || \
+  .venv/bin/pip install -q gmsh==4.15.2 meshio==5.3.5 numpy scipy
