@@ -366,15 +366,13 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
     }
 }
 
-/// Issue 5's size-jump bar on `fandisk.obj` with the defaults: 95% of the front triangles'
-/// first core tetrahedra within [1/r, r] of the last layer (97.7% measured; 99.1% of those on
-/// prisms). Its core still has 5 tetrahedra below 10 degrees (28 before the transition stacks
-/// stepped down to their stopped neighbours), so the angle bar is not asserted, only that the
-/// steps stay mended, and that the final front's caps and folds (core-side angle below 40
-/// degrees) are mostly undone (47 -> 28; counted below 20 degrees they went 15 -> 0): its 4-degree fold
-/// held a 0.02-degree sliver; the worst was 4.5 degrees then, 5.7 since front points move to
-/// mend slivers (columns' tops down their last step, pyramids' apexes), 4.0 since a cell mended
-/// by its neighbour's merge no longer stops (its saddle at (2.95, 15.58, -1.1) stacks differently).
+/// Issue 5's bars on `fandisk.obj` with the defaults: 95% of the front triangles' first core
+/// tetrahedra within [1/r, r] of the last layer (97.8% measured; 99.1% of those on prisms), and
+/// no core dihedral angle below 10 degrees (10.01 measured; 10.01 and 10.006 at growth 1.1999
+/// and 1.2001). The last slivers (4.35 degrees) were in the needle two fans left crossing at
+/// (2.75, 12.85, -2.72), their tops 0.004 apart in the transition layers: those stacks now end
+/// there (`layers.march.crushed_columns`). The final front's caps and folds (core-side angle
+/// below 40 degrees) stay mostly undone (47 -> 28 when it was counted).
 #[test]
 fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/fandisk.obj");
@@ -385,10 +383,10 @@ fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     let core = out.report.core.as_ref().expect("a core");
     let jump = &core.size_jump.stats;
     eprintln!("fandisk: size jump {jump:?}, {} slivers", core.quality.slivers.count);
-    assert!(core.quality.slivers.count <= 8, "{} tetrahedra below 10 deg", core.quality.slivers.count);
     let unfold = &out.report.layers.unfold;
     assert!(unfold.defects_after * 3 <= unfold.defects_before * 2, "{unfold:?}");
-    assert!(core.quality.min_dihedral > 3.5, "core min dihedral {:.2}", core.quality.min_dihedral);
+    assert!(out.report.layers.march.crushed_columns > 0, "the crossing fans end");
+    assert!(core.quality.min_dihedral >= 10.0, "core min dihedral {:.2}", core.quality.min_dihedral);
     assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
     let on_prisms = core.size_jump.on_prisms.within_band;
     assert!(on_prisms >= 0.95, "{:.1}% within [1/r, r] on prisms", 100.0 * on_prisms);

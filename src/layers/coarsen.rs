@@ -26,17 +26,32 @@ pub const COLLAPSE_LENGTH: f64 = FRAC_1_SQRT_2;
 /// Rounds of collapses in one slab.
 pub const MAX_ROUNDS: usize = 3;
 
+/// A front edge shorter than this against the collapse sizes that no collapse could take is
+/// crushed ([`Coarsening::crushed`]): its cells are needles along the front. Fandisk's two
+/// fans crossing were at 0.017 and 0.037; at 0.1 the arrow's fin roots ended too (0.053 to
+/// 0.09, where the fin and body fronts meet and a later layer's merges take them), and their
+/// pits left core slivers where it had none.
+pub const CRUSHED_LENGTH: f64 = 0.05;
+
+/// What [`collapse_short_edges`] did.
+pub(super) struct Coarsening {
+    /// Edges collapsed.
+    pub made: usize,
+    /// The short edges left shorter than [`CRUSHED_LENGTH`], as root pairs.
+    pub crushed: Vec<(u32, u32)>,
+}
+
 /// Collapse the plan's short front edges of layer `k` against the tangential sizes `h` at the
 /// columns' proposed tops (and the layer's height, within the user's sizes `user`);
 /// `cells_valid(plan, group)` tells whether every cell around the columns `group` is valid
-/// under the plan. Returns how many edges collapsed.
+/// under the plan.
 pub(super) fn collapse_short_edges(
     plan: &mut SlabPlan,
     front: &Front,
     columns: &Columns,
     (h, user, k): (&[f64], &[f64], u32),
     cells_valid: impl Fn(&SlabPlan, &[u32]) -> bool,
-) -> usize {
+) -> Coarsening {
     let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
     let sizes = EdgeSizes { target: h, height: &height, user };
     let mut made = 0;
@@ -59,7 +74,12 @@ pub(super) fn collapse_short_edges(
             break;
         }
     }
-    made
+    let crushed = short_edges(plan, front, columns, &sizes)
+        .into_iter()
+        .filter(|&(length, _, _)| length < CRUSHED_LENGTH)
+        .map(|(_, a, b)| (a, b))
+        .collect();
+    Coarsening { made, crushed }
 }
 
 /// The front edges `(length, a, b)` between two moving roots (after the merges so far) that are

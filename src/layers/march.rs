@@ -51,6 +51,9 @@ pub struct MarchStats {
     pub bent_columns: usize,
     /// Columns whose top tipped sideways to mend an invalid cell, instead of stopping.
     pub tipped_columns: usize,
+    /// Columns whose stack ended in its transition layers at a front edge crushed shorter than
+    /// any collapse could mend.
+    pub crushed_columns: usize,
     /// Long front edges left unsplit for a layer because the split would have made an invalid
     /// cell.
     pub splits_given_up: usize,
@@ -153,6 +156,8 @@ pub(super) struct SlabPlan {
     pub bends: usize,
     /// Columns tipped to mend an invalid cell ([`bend::nudge_to_mend`]).
     pub tips: usize,
+    /// Columns stopped in their transition layers at crushed edges ([`stop_crushed_transition`]).
+    pub crushed_stops: usize,
 }
 
 impl SlabPlan {
@@ -169,6 +174,7 @@ impl SlabPlan {
             flat_tops: 0,
             bends: 0,
             tips: 0,
+            crushed_stops: 0,
         }
     }
 
@@ -446,6 +452,7 @@ pub fn march(
         stats.flat_top_collapses += plan.flat_tops;
         stats.bent_columns += plan.bends;
         stats.tipped_columns += plan.tips;
+        stats.crushed_columns += plan.crushed_stops;
         let (split_count, swap_count) =
             commit_slab(mesh, columns, front, &plan, &reshape, sizes, k, &mut stats);
         stats.splits += split_count;
@@ -459,6 +466,31 @@ pub fn march(
     }
     stats.guard_rebuilds = guard.rebuilds;
     stats
+}
+
+/// End the stacks at the `crushed` edges ([`coarsen::Coarsening::crushed`]) whose columns are
+/// both in their transition layers, with every column of their wall points (a fan ends
+/// together); returns how many columns stopped. Converging columns that no collapse can merge
+/// (two fans crossing where a convex ridge runs into a concave corner) would go on with their
+/// tops ever closer, and the core would have to fill the needle they leave with slivers. In the
+/// transition layers an end costs no coverage.
+fn stop_crushed_transition(plan: &mut SlabPlan, columns: &Columns, crushed: &[(u32, u32)]) -> usize {
+    let in_transition =
+        |c: u32| columns.full_count(c as usize).is_some_and(|n| columns.layers[c as usize] >= n);
+    let mut ending: Vec<u32> = crushed
+        .iter()
+        .filter(|&&(a, b)| in_transition(a) && in_transition(b))
+        .flat_map(|&(a, b)| [columns.wall_vertex[a as usize], columns.wall_vertex[b as usize]])
+        .collect();
+    if ending.is_empty() {
+        return 0;
+    }
+    ending.sort_unstable();
+    ending.dedup();
+    let fans = (0..columns.len() as u32).filter(|&c| {
+        columns.alive[c as usize] && ending.binary_search(&columns.wall_vertex[c as usize]).is_ok()
+    });
+    plan.stop_all(fans).len()
 }
 
 /// End the stacks of the columns whose next layer (the `k`-th) would be at least as high as the
@@ -626,10 +658,12 @@ fn settle_slab(
         if !matches!(sizes.adapt, Adapt::Off) {
             let user = sizes.user(&plan.proposed, &columns.alive);
             let limits = (&reshape.target[..], &user[..], k);
-            plan.coarsened =
+            let coarsening =
                 coarsen::collapse_short_edges(&mut plan, front, columns, limits, |plan, group| {
                     invalid_cells(plan, group) == 0
                 });
+            plan.coarsened = coarsening.made;
+            plan.crushed_stops = stop_crushed_transition(&mut plan, columns, &coarsening.crushed);
         }
         entropy::merge_bisector_crossings(&mut plan, front, columns, &mesh.points, walls, invalid_cells);
         entropy::merge_overtaken(&mut plan, front, columns, &mesh.points, walls, k, invalid_cells);
@@ -1087,5 +1121,35 @@ fn emit_cell(mesh: &mut VolumeMesh, cell: SlabCell, stats: &mut MarchStats) {
             }
             stats.steiner_points += 1;
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::config::LayerSpec;
+
+    /// Four columns in a row, 10 layers to their full stack; columns 2 and 3 are a fan (one wall
+    /// point), column 3 the copy.
+    fn row(layers: [u32; 4]) -> (Columns, SlabPlan) {
+        let bottoms: Vec<DVec3> = (0..4).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
+        let mut columns = Columns::rising(&bottoms, Some(LayerSpec::fixed(0.1, 1.2, 10)));
+        columns.layers = layers.to_vec();
+        columns.wall_vertex[3] = 2;
+        let proposed = bottoms.iter().map(|&b| b + DVec3::Z).collect();
+        (columns, SlabPlan::moving_to(proposed))
+    }
+
+    #[test]
+    fn a_crushed_edge_in_the_transition_layers_ends_its_columns_with_their_fans() {
+        let (columns, mut plan) = row([12, 9, 11, 11]);
+        assert_eq!(
+            stop_crushed_transition(&mut plan, &columns, &[(1, 2)]),
+            0,
+            "column 1 is in its full stack"
+        );
+        assert!(plan.moving.iter().all(|&m| m));
+        assert_eq!(stop_crushed_transition(&mut plan, &columns, &[(0, 2)]), 3);
+        assert_eq!(plan.moving, [false, true, false, false], "column 3 is column 2's fan mate");
     }
 }
