@@ -109,8 +109,6 @@ pub struct ImproveStats {
     pub edge_removals: usize,
     pub smoothed_points: usize,
     pub inserted_points: usize,
-    /// Added points taken out again, each merged into a neighbour ([`TetMesh::collapse_point`]).
-    pub collapsed_points: usize,
     /// Flips and moves that gave a first core tetrahedron the last layer's height
     /// ([`TetMesh::match_front`]).
     pub front_matches: usize,
@@ -533,39 +531,6 @@ impl TetMesh {
         Change::from_qualities(Vec::new(), Vec::new(), Some((v, p)), &old, &new)
     }
 
-    /// Take the added point `v` out by merging it into its neighbour `w`: the tetrahedra at `v`
-    /// with `w` go, the others get `w` for `v`. `None` when `v` is a boundary point, `w` is not
-    /// a neighbour, or a new tetrahedron is not positive. The tetrahedra at `v` fill its star;
-    /// when every one of the cone from `w` over the star's faces is positive, the cone fills
-    /// the same star, so the mesh stays conforming. A point the mesher or an insertion left
-    /// too close to the front (a cap over a front triangle whose apex cannot move away without
-    /// flattening another) goes this way.
-    pub fn collapse_point(&self, v: u32, w: u32) -> Option<Change> {
-        if (v as usize) < self.fixed || v == w {
-            return None;
-        }
-        let remove = self.ball[v as usize].clone();
-        if !remove.iter().any(|&t| self.tets[t as usize].contains(&w)) {
-            return None;
-        }
-        let add: Vec<[u32; 4]> = remove
-            .iter()
-            .map(|&t| self.tets[t as usize])
-            .filter(|tet| !tet.contains(&w))
-            .map(|tet| tet.map(|x| if x == v { w } else { x }))
-            .collect();
-        self.change(remove, add, None)
-    }
-
-    /// The points sharing a tetrahedron with `v`.
-    fn neighbours(&self, v: u32) -> Vec<u32> {
-        let mut around: Vec<u32> =
-            self.ball[v as usize].iter().flat_map(|&t| self.tets[t as usize]).filter(|&x| x != v).collect();
-        around.sort_unstable();
-        around.dedup();
-        around
-    }
-
     /// Insert a point on the interior edge `ab`, placed where the worst of its tetrahedra is
     /// best.
     pub fn split_edge(&self, a: u32, b: u32) -> Option<Change> {
@@ -820,14 +785,6 @@ impl TetMesh {
                 stats.moved_front_points += 1;
                 return Some(change);
             }
-        }
-        let collapses = tet
-            .iter()
-            .flat_map(|&v| self.neighbours(v).into_iter().filter_map(move |w| self.collapse_point(v, w)))
-            .collect();
-        if let Some(change) = self.best_improving(collapses, rule) {
-            stats.collapsed_points += 1;
-            return Some(change);
         }
         // Insertion under the worst-first rule trades one sliver for many slightly better ones.
         if !options.insert_points || rule == Rule::WorstFirst {
@@ -1272,9 +1229,7 @@ pub fn improve_core(
     let (points, tets) = mesh.into_parts();
     let n = boundary.points.len();
     boundary.points.copy_from_slice(&points[..n]);
-    let mut core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };
-    // Points taken out by collapses leave no tetrahedron.
-    super::merge::drop_unused_points(&mut core, n);
+    let core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };
     let quality = CoreQuality {
         mesher_min_dihedral,
         mesher_histogram,
