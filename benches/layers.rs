@@ -38,6 +38,7 @@ fn main() {
         count: Some(LayerCount::Fixed(20)),
         thickness: None,
         transition: Some(false),
+        first_aspect: None,
     };
     let spec = LayerSpec::resolve(&settings, body_size).expect("a valid layer spec");
     let patch_spec = vec![Some(spec); surface.patch_names.len()];

@@ -13,6 +13,7 @@
 //! first_height = 1.0e-5        # h0, or: yplus = 1.0 with [flow_conditions] (see `crate::yplus`)
 //! growth = 1.2                 # r: layer k is h0 r^k high
 //! count = 25                   # or: thickness = 0.05, or: count = "auto" (stop at isotropy)
+//! first_aspect = 2.0           # where stacks stop: first layer at most 1/2 of the wall's edges (0: off)
 //! [[patch]]
 //! match = "face9"              # patch name or regex (whole name)
 //! role = "symmetry"            # wall | symmetry | farfield | inlet | outlet | none
@@ -42,6 +43,8 @@ use crate::yplus::FlowConditions;
 pub const DEFAULT_FIRST_HEIGHT_REL: f64 = 1e-3;
 pub const DEFAULT_GROWTH: f64 = 1.2;
 pub const DEFAULT_LAYER_COUNT: u32 = 10;
+/// Default [`LayerSettings::first_aspect`].
+pub const DEFAULT_FIRST_ASPECT: f64 = 2.0;
 pub const DEFAULT_FEATURE_ANGLE: f64 = 30.0;
 pub const DEFAULT_FAN_ANGLE: f64 = 20.0;
 /// More layers than this is certainly a mistake (and a memory blow-up).
@@ -142,6 +145,14 @@ pub struct LayerSettings {
     /// After a fixed count (or thickness), go on growing at the same rate until the cells are
     /// isotropic, so that the core starts at the last layer's size (default true).
     pub transition: Option<bool>,
+    /// The least ratio of the wall's edge length at a vertex to its first layer's height
+    /// (default [`DEFAULT_FIRST_ASPECT`]; 0 turns it off), kept where stacks stop short: where
+    /// the wall is faceted finer than that (a blunt trailing edge, a wing tip's cap) and the
+    /// stack stopped, the layers are marched again with the first height there lowered to fit
+    /// and graded back over the wall at the growth rate. A first cell taller than its wall
+    /// triangle is wide turns over where the wall curves at its own edge scale, and the stack
+    /// there gets no layer at all. Where the stacks stand, the height asked is kept.
+    pub first_aspect: Option<f64>,
 }
 
 impl LayerSettings {
@@ -154,6 +165,7 @@ impl LayerSettings {
             count: if over.thickness.is_some() { over.count } else { over.count.or(self.count) },
             thickness: if over.count.is_some() { over.thickness } else { over.thickness.or(self.thickness) },
             transition: over.transition.or(self.transition),
+            first_aspect: over.first_aspect.or(self.first_aspect),
         }
     }
 }
@@ -370,6 +382,11 @@ fn validate_layer_settings(what: &str, s: &LayerSettings) -> Result<(), ConfigEr
             return Err(bad(&name("growth"), r, "must be between 1 and 5"));
         }
     }
+    if let Some(a) = s.first_aspect {
+        if !(a.is_finite() && a >= 0.0) {
+            return Err(bad(&name("first_aspect"), a, "must be a ratio of 0 (off) or more"));
+        }
+    }
     if let Some(t) = s.thickness {
         if !(t.is_finite() && t > 0.0) {
             return Err(bad(&name("thickness"), t, "must be a positive length"));
@@ -392,6 +409,8 @@ pub struct LayerSpec {
     pub count: LayerCount,
     /// Transition layers after a fixed count ([`LayerSettings::transition`]).
     pub transition: bool,
+    /// [`LayerSettings::first_aspect`].
+    pub first_aspect: f64,
     /// See [`LayerSpec::max_count`].
     max_count: u32,
 }
@@ -406,6 +425,7 @@ impl LayerSpec {
             count: Some(LayerCount::Fixed(count)),
             thickness: None,
             transition: Some(false),
+            first_aspect: None,
         };
         LayerSpec::resolve(&settings, 1.0).expect("valid test settings")
     }
@@ -428,7 +448,8 @@ impl LayerSpec {
             (LayerCount::Auto, Some(t)) => layers_for_thickness(first_height, growth, t)?,
             (LayerCount::Auto, None) => AUTO_MAX_LAYERS,
         };
-        Ok(LayerSpec { first_height, growth, count, transition, max_count })
+        let first_aspect = s.first_aspect.unwrap_or(DEFAULT_FIRST_ASPECT);
+        Ok(LayerSpec { first_height, growth, count, transition, first_aspect, max_count })
     }
 
     /// The most layers a column gets: the fixed count (with transition layers: the cap of an
@@ -535,6 +556,8 @@ mod tests {
             "[layers]\ngrowth = 0.9",
             "[layers]\nfirst_height = 1.0\nthickness = 0.5",
             "[layers]\ncount = 5\nthickness = 0.5",
+            "[layers]\nfirst_aspect = -1.0",
+            "[[patch]]\nmatch = \"wing\"\nfirst_aspect = nan",
             "feature_angle = 200.0",
             "[[patch]]\nmatch = \"(\"",
         ];
@@ -601,6 +624,7 @@ mod tests {
             thickness: Some(7.0),
             count: None,
             transition: None,
+            first_aspect: None,
         };
         let spec = LayerSpec::resolve(&s, 1.0).unwrap();
         assert_eq!(spec.count, LayerCount::Fixed(3)); // 1 + 2 + 4 = 7

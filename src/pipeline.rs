@@ -105,6 +105,12 @@ pub struct LayerSummary {
     /// Wall vertices whose column stopped at the medial surface of a thin gap.
     pub gap_limited_vertices: usize,
     pub smoothness: crate::layers::smoothness::Smoothness,
+    /// Wall vertices whose first layer is lower than asked: fitted where stacks stopped under
+    /// a first layer too tall for the wall ([`crate::config::LayerSettings::first_aspect`]),
+    /// graded around, or graded from a patch with a lower one; and the lowest ratio to the
+    /// height asked (1 when none).
+    pub lowered_first_height_vertices: usize,
+    pub lowest_first_height_ratio: f64,
 }
 
 #[derive(Clone, Debug, Default, Serialize)]
@@ -391,6 +397,8 @@ fn layer_summary(
         gap_limited_vertices: layered.gap_limited_vertices.len(),
         unfold: layered.unfold.clone(),
         smoothness: layered.smoothness.clone(),
+        lowered_first_height_vertices: layered.lowered_first_heights.len(),
+        lowest_first_height_ratio: layered.lowered_first_heights.iter().map(|l| l.1).fold(1.0, f64::min),
     }
 }
 
@@ -424,6 +432,13 @@ impl std::fmt::Display for MeshReport {
             l.stopped_vertices,
             l.gap_limited_vertices
         )?;
+        if l.lowered_first_height_vertices > 0 {
+            writeln!(
+                f,
+                "          first layer lowered at {} wall vertices (down to {:.3} of the height asked): fitted where stacks stopped under a first layer taller than the wall's edges over [layers] first_aspect, graded around (or from a patch with a lower one)",
+                l.lowered_first_height_vertices, l.lowest_first_height_ratio
+            )?;
+        }
         let sm = &l.smoothness;
         write!(
             f,

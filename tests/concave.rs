@@ -17,6 +17,7 @@ fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
             count: Some(LayerCount::Fixed(layers)),
             thickness: None,
             transition: Some(false),
+            first_aspect: None,
         },
         ..Default::default()
     };

@@ -27,6 +27,7 @@ fn config(surface: &Surface, count: u32) -> Config {
             count: Some(LayerCount::Fixed(count)),
             thickness: None,
             transition: None,
+            first_aspect: None,
         },
         ..Default::default()
     }
@@ -366,6 +367,16 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
     }
 }
 
+/// The whole mesh of shared surface `name` with the defaults, through the checker.
+fn default_mesh_of_shared(name: &str) -> blmesh::pipeline::MeshOutput {
+    let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
+    let surface = blmesh::io::read_surface(Path::new(&path)).expect("the surface reads");
+    let out = run(surface, &Config::default(), &MeshOptions { core: true }, Progress::hidden())
+        .expect("the surface meshes");
+    assert!(out.report.check.is_valid(), "{name}: {}", out.report.check);
+    out
+}
+
 /// Issue 5's bars on `fandisk.obj` with the defaults: 95% of the front triangles' first core
 /// tetrahedra within [1/r, r] of the last layer (97.8% measured; 99.1% of those on prisms), and
 /// no core dihedral angle below 10 degrees (10.01 measured; 10.01 and 10.006 at growth 1.1999
@@ -375,11 +386,7 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
 /// below 40 degrees) stay mostly undone (47 -> 28 when it was counted).
 #[test]
 fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
-    let path = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/fandisk.obj");
-    let surface = blmesh::io::read_surface(Path::new(path)).expect("fandisk reads");
-    let out = run(surface, &Config::default(), &MeshOptions { core: true }, Progress::hidden())
-        .expect("fandisk meshes");
-    assert!(out.report.check.is_valid(), "{}", out.report.check);
+    let out = default_mesh_of_shared("fandisk.obj");
     let core = out.report.core.as_ref().expect("a core");
     let jump = &core.size_jump.stats;
     eprintln!("fandisk: size jump {jump:?}, {} slivers", core.quality.slivers.count);
@@ -390,4 +397,22 @@ fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
     let on_prisms = core.size_jump.on_prisms.within_band;
     assert!(on_prisms >= 0.95, "{:.1}% within [1/r, r] on prisms", 100.0 * on_prisms);
+}
+
+/// Issue 5 on the ONERA M6 half wing meshed whole (`face9` a wall), with the defaults: the
+/// wing tip's blunt trailing edge and cap are faceted at 0.2-0.4 under a first layer of 1.675
+/// (H = 1e-3 D), and 49 of its wall vertices got no layer. Those stacks' first height is now
+/// fitted to the wall ([layers] first_aspect, graded around) and the layers marched again:
+/// 21 stopped wall vertices (measured), 10-12 core tetrahedra below 10 degrees (101-136
+/// before, over growth 1.1999-1.2001), and the size jump bar still held (98.4%).
+#[test]
+fn onera_m6_tip_gets_its_layers_with_a_first_height_fitted_to_the_wall() {
+    let out = default_mesh_of_shared("onera_m6_gmsh_coarse.stl");
+    let layers = &out.report.layers;
+    assert!(layers.lowered_first_height_vertices > 0);
+    assert!(layers.stopped_vertices <= 30, "{} stopped", layers.stopped_vertices);
+    let core = out.report.core.as_ref().expect("a core");
+    assert!(core.quality.slivers.count <= 30, "{} tetrahedra below 10 deg", core.quality.slivers.count);
+    let jump = &core.size_jump.stats;
+    assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
 }

@@ -24,6 +24,7 @@ fn mesh_layers(surface: &Surface) -> (MeshOutput, f64) {
             count: Some(LayerCount::Fixed(LAYERS)),
             thickness: None,
             transition: Some(false),
+            first_aspect: None,
         },
         ..Default::default()
     };
@@ -159,6 +160,7 @@ fn auto_count_stops_at_isotropy_smoothly() {
                 count: Some(LayerCount::Auto),
                 thickness: None,
                 transition: None,
+                first_aspect: None,
             },
             ..Default::default()
         };
@@ -189,6 +191,7 @@ fn transition_layers_carry_a_fixed_count_to_isotropy() {
             count: Some(LayerCount::Fixed(5)),
             thickness: None,
             transition,
+            first_aspect: None,
         };
         let mesh = |transition| {
             let config = Config { layers: settings(transition), ..Default::default() };
@@ -238,4 +241,20 @@ fn patch_settings_meet_without_steps() {
     let border = &out.report.layers.smoothness.patch_border_thickness_ratio;
     assert!(border.count > 1000 && border.within_band >= 0.9, "{border:?}");
     assert!(out.report.layers.full_coverage >= 0.95, "{}", out.report.layers.full_coverage);
+}
+
+/// `first_aspect` (default 2) lowers the first height only where stacks stop short under a
+/// first layer too tall for the wall's facets: a box faceted at 0.17-0.33 under a first height
+/// of 0.15 stands everywhere, so it keeps the height asked.
+#[test]
+fn a_first_layer_taller_than_half_the_walls_edges_stays_where_its_stacks_stand() {
+    let surface = shapes::cuboid(DVec3::new(2.0, 1.5, 1.0), 6);
+    let config = Config::from_toml_str("[layers]\nfirst_height = 0.15\ncount = 3\ntransition = false\n")
+        .expect("a valid config");
+    let out =
+        run(surface, &config, &MeshOptions { core: false }, Progress::hidden()).expect("the box meshes");
+    assert!(out.report.check.is_valid(), "{}", out.report.check);
+    assert_eq!(out.report.layers.full_coverage, 1.0);
+    assert_eq!(out.report.layers.lowered_first_height_vertices, 0);
+    assert_eq!(out.report.layers.lowest_first_height_ratio, 1.0);
 }

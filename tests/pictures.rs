@@ -25,6 +25,7 @@ fn box_layers() -> VolumeMesh {
             count: Some(LayerCount::Fixed(10)),
             thickness: None,
             transition: Some(false),
+            first_aspect: None,
         },
         ..Default::default()
     };

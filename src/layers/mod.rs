@@ -23,6 +23,7 @@ use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
 use crate::normals::constraint::Slide;
 use crate::normals::WallNormals;
+use crate::sizing::wall::mean_edge_length_per_vertex;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
 
@@ -56,6 +57,11 @@ pub struct Layers {
     pub smoothness: smoothness::Smoothness,
     /// The caps and folds of the final front, and the tops pulled back to undo them.
     pub unfold: unfold::UnfoldStats,
+    /// Wall vertices whose first height is below the one asked for, with the ratio (the
+    /// smallest over their columns): fitted to a finely faceted wall
+    /// ([`LayerSettings::first_aspect`](crate::config::LayerSettings::first_aspect)), or graded
+    /// from such a place or from a patch with a smaller one.
+    pub lowered_first_heights: Vec<(u32, f64)>,
 }
 
 /// Extrude the wall. `patch_spec[p]` is the layer stack of patch `p`, `None` for patches
@@ -69,27 +75,30 @@ pub fn build_layers(
     adapt: Adapt,
     mut on_layer: impl FnMut(u32, u32),
 ) -> Layers {
-    let (mut columns, mut front) = front::initial_front(surface, normals);
-    // The faces without layers never move: leave them out of the front.
     let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
-    front.retain_patches(layered, columns.len());
-    let mut column_spec = column_specs(normals, &front, patch_spec);
-    grade_first_heights(surface, &columns, &mut column_spec);
-    columns.spec = column_spec;
-    for c in 0..columns.len() {
-        columns.alive[c] = columns.spec[c].is_some() && columns.slide[c] != Slide::Fixed;
+    let start = MarchStart { surface, topology, normals, patch_spec, adapt };
+    let mut fitted = vec![false; surface.points.len()];
+    let mut marched = start.march(&fitted, &mut on_layer);
+    // Stacks stopped short where the first layer is too tall for the wall's facets: march
+    // again with the first height fitted there (and graded around).
+    for _ in 0..REFITS {
+        let refit: Vec<u32> = stopped_too_tall_for_the_wall(surface, &marched)
+            .into_iter()
+            .filter(|&v| !fitted[v as usize])
+            .collect();
+        if refit.is_empty() {
+            break;
+        }
+        tracing::info!(
+            vertices = refit.len(),
+            "first layer too tall for the wall: marching again with it fitted"
+        );
+        for v in refit {
+            fitted[v as usize] = true;
+        }
+        marched = start.march(&fitted, &mut on_layer);
     }
-    let max_layers = (0..columns.len()).filter_map(|c| columns.target(c)).max().unwrap_or(0);
-    let mut mesh = VolumeMesh {
-        points: surface.points.clone(),
-        zone_names: vec![LAYER_ZONE_NAME.to_owned()],
-        ..Default::default()
-    };
-    let mut sizes = split::Sizes::new(adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
-    let walls = entropy::VertexWalls::new(surface, topology, layered);
-    let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, &walls, |k| {
-        on_layer(k, max_layers)
-    });
+    let Marched { mut mesh, mut columns, front, sizes, stats, lowered_first_heights } = marched;
     let unfold = unfold::unfold_front(&mut mesh, &mut columns, &front, surface, layered);
     let front_edges = sizes.front_edge_lengths(&mesh.points, &columns, &front);
     add_boundary(&mut mesh, surface, &front, &columns);
@@ -140,7 +149,82 @@ pub fn build_layers(
         gap_limited_vertices,
         smoothness,
         unfold,
+        lowered_first_heights,
     }
+}
+
+/// Marches again at most, each with the first height fitted at more wall vertices.
+const REFITS: usize = 2;
+
+/// What a march starts from: the wall, its normals and the patches' stacks.
+struct MarchStart<'a> {
+    surface: &'a Surface,
+    topology: &'a Topology,
+    normals: &'a WallNormals,
+    patch_spec: &'a [Option<LayerSpec>],
+    adapt: Adapt<'a>,
+}
+
+/// A march's result, before the front is unfolded and the layers are counted.
+struct Marched<'a> {
+    mesh: VolumeMesh,
+    columns: front::Columns,
+    front: front::Front,
+    sizes: split::Sizes<'a>,
+    stats: MarchStats,
+    lowered_first_heights: Vec<(u32, f64)>,
+}
+
+impl<'a> MarchStart<'a> {
+    /// March from the wall, the first heights fitted to the wall at the wall vertices marked
+    /// `fitted` ([`fit_first_heights_to_wall`]) and graded across the wall.
+    fn march(&self, fitted: &[bool], on_layer: &mut impl FnMut(u32, u32)) -> Marched<'a> {
+        let (surface, patch_spec) = (self.surface, self.patch_spec);
+        let (mut columns, mut front) = front::initial_front(surface, self.normals);
+        // The faces without layers never move: leave them out of the front.
+        let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
+        front.retain_patches(layered, columns.len());
+        let mut column_spec = column_specs(self.normals, &front, patch_spec);
+        let requested = column_spec.clone();
+        fit_first_heights_to_wall(surface, &columns, fitted, &mut column_spec);
+        grade_first_heights(surface, &columns, &mut column_spec);
+        let lowered_first_heights = lowered_first_heights(&columns, &requested, &column_spec);
+        columns.spec = column_spec;
+        for c in 0..columns.len() {
+            columns.alive[c] = columns.spec[c].is_some() && columns.slide[c] != Slide::Fixed;
+        }
+        let max_layers = (0..columns.len()).filter_map(|c| columns.target(c)).max().unwrap_or(0);
+        let mut mesh = VolumeMesh {
+            points: surface.points.clone(),
+            zone_names: vec![LAYER_ZONE_NAME.to_owned()],
+            ..Default::default()
+        };
+        let mut sizes =
+            split::Sizes::new(self.adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
+        let walls = entropy::VertexWalls::new(surface, self.topology, layered);
+        let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, &walls, |k| {
+            on_layer(k, max_layers)
+        });
+        Marched { mesh, columns, front, sizes, stats, lowered_first_heights }
+    }
+}
+
+/// The wall vertices whose stack stopped short of its full count with a first layer taller
+/// than the mean length of the wall's edges there over the stack's `first_aspect`.
+fn stopped_too_tall_for_the_wall(surface: &Surface, marched: &Marched) -> Vec<u32> {
+    let columns = &marched.columns;
+    let size = mean_edge_length_per_vertex(&surface.points, &surface.triangles);
+    let mut vertices: Vec<u32> = (0..columns.len())
+        .filter(|&c| {
+            let Some(spec) = columns.spec[c] else { return false };
+            let short = columns.layers[columns.carrier(c)] < spec.full_count();
+            short && spec.first_aspect * spec.first_height > size[columns.wall_vertex[c] as usize]
+        })
+        .map(|c| columns.wall_vertex[c])
+        .collect();
+    vertices.sort_unstable();
+    vertices.dedup();
+    vertices
 }
 
 /// The layer stack of each column: that of the first front face using it, `None` if any face
@@ -163,6 +247,49 @@ fn column_specs(
         }
     }
     spec.into_iter().map(Option::flatten).collect()
+}
+
+/// Lower the first height of every column whose wall is faceted finer than its spec's
+/// `first_aspect` first heights (the mean length of the wall edges at its vertex) to that
+/// size over `first_aspect`, at the wall vertices marked `fitted`; [`grade_first_heights`] then grades the lowered heights back over
+/// the wall. On the ONERA M6 wing tip (edges 0.2-0.4 under a first layer of 1.675, H = 1e-3 D)
+/// the stacks stopped in their first layer: 49 wall vertices without a layer.
+fn fit_first_heights_to_wall(
+    surface: &Surface,
+    columns: &front::Columns,
+    fitted: &[bool],
+    column_spec: &mut [Option<LayerSpec>],
+) {
+    let size = mean_edge_length_per_vertex(&surface.points, &surface.triangles);
+    for (c, spec) in column_spec.iter_mut().enumerate() {
+        let v = columns.wall_vertex[c] as usize;
+        if !fitted[v] {
+            continue;
+        }
+        let size = size[v];
+        if let Some(s) = spec.as_mut().filter(|s| s.first_aspect > 0.0) {
+            s.first_height = s.first_height.min(size / s.first_aspect);
+        }
+    }
+}
+
+/// The wall vertices whose columns' first height in `spec` is below the `requested` one, with
+/// the smallest ratio over their columns, by vertex.
+fn lowered_first_heights(
+    columns: &front::Columns,
+    requested: &[Option<LayerSpec>],
+    spec: &[Option<LayerSpec>],
+) -> Vec<(u32, f64)> {
+    let mut lowered: Vec<(u32, f64)> = (0..columns.len())
+        .filter_map(|c| {
+            let (r, s) = (requested[c]?, spec[c]?);
+            (s.first_height < r.first_height)
+                .then(|| (columns.wall_vertex[c], s.first_height / r.first_height))
+        })
+        .collect();
+    lowered.sort_unstable_by(|x, y| x.0.cmp(&y.0).then(x.1.total_cmp(&y.1)));
+    lowered.dedup_by_key(|x| x.0);
+    lowered
 }
 
 /// The share of the growth ratio (as an exponent) that neighbouring first heights may differ by.
@@ -310,6 +437,32 @@ fn top_polygon(front: &front::Front, columns: &front::Columns, f: usize) -> Opti
 
 #[cfg(test)]
 mod tests {
+    use crate::surface::shapes::cuboid;
+
+    #[test]
+    fn the_first_height_is_fitted_to_the_wall_only_where_asked() {
+        // A unit cube faceted at 1/4 (mean edge length at its vertices 0.25 to 0.3).
+        let surface = cuboid(DVec3::ONE, 4);
+        let columns = front::Columns::rising(&surface.points, Some(LayerSpec::fixed(0.5, 1.2, 5)));
+        let mut spec = columns.spec.clone();
+        let mut fitted = vec![false; surface.points.len()];
+        fitted[0] = true;
+        fit_first_heights_to_wall(&surface, &columns, &fitted, &mut spec);
+        let size = mean_edge_length_per_vertex(&surface.points, &surface.triangles);
+        let height = |c: usize| spec[c].unwrap().first_height;
+        assert!((height(0) - size[0] / 2.0).abs() < 1e-12, "{} vs {}", height(0), size[0]);
+        assert!((1..surface.points.len()).all(|c| height(c) == 0.5));
+        let lowered = lowered_first_heights(&columns, &columns.spec, &spec);
+        assert_eq!(lowered, vec![(0, height(0) / 0.5)]);
+        // Off with a first aspect of 0.
+        let mut off = columns.spec.clone();
+        for s in off.iter_mut().flatten() {
+            s.first_aspect = 0.0;
+        }
+        fit_first_heights_to_wall(&surface, &columns, &fitted, &mut off);
+        assert_eq!(off[0].unwrap().first_height, 0.5);
+    }
+
     use super::*;
     use glam::DVec3;
 

@@ -14,6 +14,7 @@ pub fn layered_box() -> (Surface, Config) {
         count: Some(LayerCount::Fixed(5)),
         thickness: None,
         transition: Some(false),
+        first_aspect: None,
     };
     (surface, Config { layers, ..Default::default() })
 }
