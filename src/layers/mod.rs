@@ -209,15 +209,19 @@ impl<'a> MarchStart<'a> {
     }
 }
 
-/// The wall vertices whose stack stopped short of its full count with a first layer taller
-/// than the mean length of the wall's edges there over the stack's `first_aspect`.
+/// The wall vertices whose stack stopped short of its full count (not at isotropy) with a
+/// first layer taller than the mean length of the wall's edges there over the stack's
+/// `first_aspect`.
 fn stopped_too_tall_for_the_wall(surface: &Surface, marched: &Marched) -> Vec<u32> {
     let columns = &marched.columns;
     let size = mean_edge_length_per_vertex(&surface.points, &surface.triangles);
     let mut vertices: Vec<u32> = (0..columns.len())
         .filter(|&c| {
             let Some(spec) = columns.spec[c] else { return false };
-            let short = columns.layers[columns.carrier(c)] < spec.full_count();
+            // A stack ended at isotropy is complete.
+            let carrier = columns.carrier(c);
+            let short =
+                columns.layers[carrier] < spec.full_count() && columns.isotropic_ratio[carrier].is_nan();
             short && spec.first_aspect * spec.first_height > size[columns.wall_vertex[c] as usize]
         })
         .map(|c| columns.wall_vertex[c])
