@@ -18,10 +18,10 @@
 //! match = "face9"              # patch name or regex (whole name)
 //! role = "symmetry"            # wall | symmetry | farfield | inlet | outlet | none
 //! first_height = 2.0e-5        # per-patch layer overrides (wall patches), or yplus = ...
-//! [sizing]                     # tangential sizes the layers' front is split to
+//! [sizing]                     # tangential sizes the layers' front is split to, and the core's
 //! adapt = true                 # split/collapse front edges to the tangential sizes (default; --no-adapt)
 //! max_size = 0.5               # with max_size or regions: a sizing field (see `crate::sizing`)
-//! gradation = 1.2
+//! gradation = 1.2              # core sizes grow by 0.2 per unit length from the front's (1 < g <= 3)
 //! [[sizing.regions]]
 //! shape = "sphere"             # or "box" with min = [..], max = [..]
 //! center = [0.0, 0.0, 0.0]
@@ -290,6 +290,17 @@ impl Config {
         let fan = self.fan_angle();
         if !(fan.is_finite() && fan >= 1.0 && fan <= 90.0) {
             return Err(bad("fan_angle", fan, "must be between 1 and 90 degrees"));
+        }
+        if let Some(g) = self.sizing.gradation {
+            // At 1 the core would be as fine as the finest front everywhere.
+            if !(g.is_finite() && g > 1.0 && g <= 3.0) {
+                return Err(bad("sizing.gradation", g, "must be a ratio above 1 and at most 3"));
+            }
+        }
+        if let Some(m) = self.sizing.max_size {
+            if !(m.is_finite() && m > 0.0) {
+                return Err(bad("sizing.max_size", m, "must be a positive length"));
+            }
         }
         validate_layer_settings("layers", &self.layers)?;
         for rule in &self.patches {
@@ -560,6 +571,9 @@ mod tests {
             "[[patch]]\nmatch = \"wing\"\nfirst_aspect = nan",
             "feature_angle = 200.0",
             "[[patch]]\nmatch = \"(\"",
+            "[sizing]\ngradation = 1.0",
+            "[sizing]\ngradation = 4.0",
+            "[sizing]\nmax_size = 0.0",
         ];
         for text in bad_cases {
             let c = Config::from_toml_str(text).unwrap();

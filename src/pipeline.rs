@@ -482,9 +482,16 @@ impl std::fmt::Display for MeshReport {
                     "core      {} tetrahedra ({} pyramids on front quads), dihedral {:.1}..{:.1} deg (TetGen's min {:.1}), {} boundary points added",
                     c.tetrahedra, c.pyramids, c.min_dihedral, c.max_dihedral, q.mesher_min_dihedral, c.boundary_steiner_points
                 )?;
+                let sizes = match (c.gradation, c.region_points) {
+                    (Some(g), 0) => format!("sizes graded by {g} from the front's"),
+                    (Some(g), n) => {
+                        format!("sizes graded by {g} from the front's and the regions' ({n} points)")
+                    }
+                    (None, _) => "TetGen's own sizes".to_owned(),
+                };
                 writeln!(
                     f,
-                    "          {} seeds over the front in place (of {} front vertices with a last layer under them)",
+                    "          {sizes}; {} seeds over the front in place (of {} front vertices with a last layer under them)",
                     c.seeds, c.seed_candidates
                 )?;
                 if c.mesher_crashes > 0 {

@@ -8,6 +8,7 @@ use std::collections::HashMap;
 use std::path::Path;
 
 use blmesh::config::{Config, Flow, LayerCount, LayerSettings, PatchRule, Role};
+use blmesh::fill::grading::CoreSizing;
 use blmesh::fill::{fill_core, CoreOptions, CoreStats, FillError, DEFAULT_FARFIELD_FACTOR, FARFIELD_PATCH};
 use blmesh::geometry::DVec3;
 use blmesh::layers::TOP_PATCH;
@@ -15,6 +16,7 @@ use blmesh::mesh::{CellKind, VolumeMesh};
 use blmesh::pipeline::{run, MeshOptions};
 use blmesh::progress::Progress;
 use blmesh::quality;
+use blmesh::sizing::Region;
 use blmesh::surface::{shapes, Surface};
 
 /// `count` layers, h0 = 1e-4 of the bounding-box diagonal, r = 1.2 (as tests/layers.rs).
@@ -141,6 +143,84 @@ fn sphere_with_layers() {
     // The core quality bar of issue 5, reached by our improvement (TetGen alone: 6.6 degrees).
     assert!(stats.min_dihedral >= 10.0, "sphere: core min dihedral {:.2}", stats.min_dihedral);
     assert_eq!(stats.quality.slivers.count, 0);
+}
+
+/// The edges of the core's tetrahedra (each once per tetrahedron), as their two ends.
+fn core_edges(mesh: &VolumeMesh) -> Vec<(DVec3, DVec3)> {
+    let core = mesh.zone_names.iter().position(|z| z == "core").expect("a core zone") as u32;
+    let block = mesh.block(CellKind::Tetrahedron);
+    let cells = block.iter().zip(&block.zone).filter(|(_, &zone)| zone == core);
+    cells
+        .flat_map(|(cell, _)| {
+            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                .map(|(i, j)| (mesh.points[cell[i] as usize], mesh.points[cell[j] as usize]))
+        })
+        .collect()
+}
+
+/// The 90th percentile of `values`.
+fn percentile_90(mut values: Vec<f64>) -> f64 {
+    values.sort_by(f64::total_cmp);
+    values[values.len() * 9 / 10]
+}
+
+/// The core's edge lengths at distance `d` from the unit sphere's layers, over the size there
+/// if they grew by 0.2 per unit length from the front's edges (`front_edge`): the 90th
+/// percentile of that ratio over the edges 1 to 5 sphere radii out.
+fn core_edge_growth(mesh: &VolumeMesh, front_edge: f64, thickness: f64) -> f64 {
+    let distance = |a: DVec3, b: DVec3| ((a + b) / 2.0).length() - 1.0 - thickness;
+    let edges = core_edges(mesh).into_iter().filter(|&(a, b)| (1.0..5.0).contains(&distance(a, b)));
+    percentile_90(edges.map(|(a, b)| a.distance(b) / (front_edge + 0.2 * distance(a, b))).collect())
+}
+
+/// DESIGN.md step 7: the core's sizes grow from the front's by the gradation (1.2: edges 0.2
+/// longer per unit length), not as fast as the distance (the mesher's own interpolation).
+#[test]
+fn the_core_sizes_grow_by_the_gradation() {
+    let wall = shapes::icosphere(1.0, 3);
+    let layers = layered(&wall, &config(&wall, 10));
+    let front_edge = 2.0 * std::f64::consts::PI / 40.0;
+    let thickness = layers.points.iter().map(|p| p.length()).fold(0.0, f64::max) - 1.0;
+    let graded = CoreOptions::default();
+    let stats = fill_and_check("sphere graded", &layers, &wall, &graded, external_volume(&wall));
+    assert_eq!(stats.gradation, Some(1.2));
+    let (mesh, _) = fill_core(&layers, &wall, &graded).expect("fills");
+    let growth = core_edge_growth(&mesh, front_edge, thickness);
+    let own = CoreOptions { sizing: None, ..Default::default() };
+    let (ungraded, stats) = fill_core(&layers, &wall, &own).expect("fills");
+    assert_eq!(stats.gradation, None);
+    let ungraded_growth = core_edge_growth(&ungraded, front_edge, thickness);
+    eprintln!("edge over graded size, 90th percentile: {growth:.2} graded, {ungraded_growth:.2} not");
+    // TetGen bounds circumradii (1.2 sizes), and a tetrahedron's edges reach 1.6 of its circumradius.
+    assert!(growth < 2.0, "graded: {growth}");
+    assert!(ungraded_growth > 1.5 * growth, "the mesher's own sizes grow faster: {ungraded_growth}");
+}
+
+/// The 90th percentile of the lengths of the core's edges with their midpoint in `region`.
+fn core_edges_in(mesh: &VolumeMesh, region: &Region) -> f64 {
+    let inside = core_edges(mesh).into_iter().filter(|&(a, b)| region.distance((a + b) / 2.0) == 0.0);
+    percentile_90(inside.map(|(a, b)| a.distance(b)).collect())
+}
+
+/// A refinement region (`[[sizing.regions]]`) refines the core too: a wake box behind the
+/// sphere, 0.1 inside, where the graded core alone has edges of about 0.5.
+#[test]
+fn a_refinement_region_refines_the_core() {
+    let wall = shapes::icosphere(1.0, 3);
+    let layers = layered(&wall, &config(&wall, 10));
+    let wake = Region::Box { min: DVec3::new(1.5, -0.5, -0.5), max: DVec3::new(4.0, 0.5, 0.5), size: 0.1 };
+    let sizing = CoreSizing { regions: vec![wake.clone()], ..Default::default() };
+    let refined = CoreOptions { sizing: Some(sizing), ..Default::default() };
+    let stats = fill_and_check("sphere with a wake box", &layers, &wall, &refined, external_volume(&wall));
+    assert!(stats.region_points > 0);
+    let (mesh, _) = fill_core(&layers, &wall, &refined).expect("fills");
+    let (plain, stats) = fill_core(&layers, &wall, &CoreOptions::default()).expect("fills");
+    assert_eq!(stats.region_points, 0);
+    let (inside, before) = (core_edges_in(&mesh, &wake), core_edges_in(&plain, &wake));
+    eprintln!("edges in the wake box, 90th percentile: {inside:.3} refined, {before:.3} not");
+    // TetGen bounds circumradii (1.2 sizes): edges reach about twice the size.
+    assert!(inside < 0.25, "refined: {inside}");
+    assert!(before > 1.6 * inside, "without the region: {before}");
 }
 
 /// The core quality bar of issue 5 on the box (20 layers, then transition layers to isotropy):

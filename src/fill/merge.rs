@@ -97,7 +97,8 @@ pub(super) fn seeds_in_place_first(
     }
     let mut placed = vec![false; core.points.len()];
     let mut order: Vec<usize> = (0..n).collect();
-    for i in guide.interior.iter().filter_map(|g| at.get(&key(*g)).copied()) {
+    let seeds = &guide.interior[..guide.interior.len() - guide.sizing_points];
+    for i in seeds.iter().filter_map(|g| at.get(&key(*g)).copied()) {
         if !std::mem::replace(&mut placed[i], true) {
             order.push(i);
         }

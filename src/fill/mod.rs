@@ -9,6 +9,7 @@
 
 pub mod farfield;
 mod front;
+pub mod grading;
 pub mod improve;
 #[cfg(feature = "tetgen")]
 pub(crate) mod isolate;
@@ -189,9 +190,13 @@ fn sorted_triangle(mut t: [u32; 3]) -> [u32; 3] {
 /// interior point; the mesher grades the sizes in between.
 #[derive(Clone, Debug, Default)]
 pub struct CoreGuide {
+    /// The seeds, then `sizing_points` points that only carry sizes inside.
     pub interior: Vec<DVec3>,
     /// `boundary.points.len() + interior.len()` sizes, or none (the mesher's own sizes).
     pub size: Vec<f64>,
+    /// How many of the last interior points carry sizes only (a first fill's points, see
+    /// [`grading`]): they are not seeds, and the improvement may move them.
+    pub sizing_points: usize,
 }
 
 impl CoreGuide {
@@ -201,6 +206,7 @@ impl CoreGuide {
         CoreGuide {
             interior: Vec::new(),
             size: crate::sizing::wall::mean_edge_length_per_vertex(&boundary.points, &boundary.triangles),
+            sizing_points: 0,
         }
     }
 
@@ -302,12 +308,19 @@ pub struct CoreOptions {
     pub improve: improve::ImproveOptions,
     /// Give the mesher a point over every front vertex at the last layer's height ([`seeds`]).
     pub seed_front: bool,
+    /// The core's sizes beyond the boundary's ([`grading`]); `None`: the mesher's own.
+    pub sizing: Option<grading::CoreSizing>,
 }
 
 impl Default for CoreOptions {
     /// External flow in the default box farfield.
     fn default() -> Self {
-        CoreOptions { farfield: Some(FarfieldSpec::default()), improve: Default::default(), seed_front: true }
+        CoreOptions {
+            farfield: Some(FarfieldSpec::default()),
+            improve: Default::default(),
+            seed_front: true,
+            sizing: Some(grading::CoreSizing::default()),
+        }
     }
 }
 
@@ -318,7 +331,15 @@ impl CoreOptions {
             Flow::External => Some(FarfieldSpec { shape: config.farfield, ..Default::default() }),
             Flow::Internal => None,
         };
-        CoreOptions { farfield, ..Default::default() }
+        CoreOptions {
+            farfield,
+            sizing: Some(grading::CoreSizing {
+                gradation: config.sizing.gradation.unwrap_or(crate::sizing::DEFAULT_GRADATION),
+                max_size: config.sizing.max_size,
+                regions: config.sizing.regions.clone(),
+            }),
+            ..Default::default()
+        }
     }
 }
 
@@ -337,6 +358,11 @@ pub struct CoreStats {
     pub mesher_crashes: usize,
     /// Points the mesher added on the boundary (0: the front is kept exactly).
     pub boundary_steiner_points: usize,
+    /// The ratio the core's sizes grew by from the boundary ([`grading`]); `None`: the
+    /// mesher's own sizes.
+    pub gradation: Option<f64>,
+    /// Points sampled in the refinement regions for the mesher ([`grading::region_points`]).
+    pub region_points: usize,
     /// Smallest and largest dihedral angle of the core tetrahedra, degrees.
     pub min_dihedral: f64,
     pub max_dihedral: f64,
@@ -417,11 +443,16 @@ pub fn fill_core_with_symmetry(
     let (mut boundary, nodes) = core.closed_boundary();
     let front_layer = core.front_layer(&nodes, false);
     let mesher_start = Instant::now();
-    let (tets, seeds_used, seeds, mesher_crashes) = if options.seed_front {
+    let SeededFill { tets, seeds_used, seeds, crashes: mesher_crashes, guide } = if options.seed_front {
         fill_with_seeds(mesher, &boundary, &front_layer, || core.front_layer(&nodes, true))?
     } else {
-        let (tets, _) = fill_keeping_boundary(mesher, &boundary, CoreGuide::mean_edge_length(&boundary))?;
-        (tets, 0, seeds::Seeds::default(), 0)
+        let mut guide = CoreGuide::mean_edge_length(&boundary);
+        let (tets, _) = fill_keeping_boundary(mesher, &boundary, &mut guide)?;
+        SeededFill { tets, seeds_used: 0, seeds: seeds::Seeds::default(), crashes: 0, guide }
+    };
+    let (tets, seeds_used, graded) = match &options.sizing {
+        Some(sizing) => grading::fill_graded(mesher, &boundary, tets, seeds_used, guide, sizing),
+        None => (tets, seeds_used, grading::Graded::default()),
     };
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();
     // The seeds stay where they are: they give the first core cells the last layer's height.
@@ -442,30 +473,49 @@ pub fn fill_core_with_symmetry(
     stats.seeds = seeds_used;
     stats.seed_candidates = seeds.candidates;
     stats.mesher_crashes = mesher_crashes;
+    stats.gradation = options.sizing.as_ref().filter(|_| graded.graded).map(|s| s.gradation);
+    stats.region_points = graded.region_points;
     stats.boundary_steiner_points = tets.boundary_steiner_points;
     stats.mesher_seconds = mesher_seconds;
     stats.seconds = start.elapsed().as_secs_f64();
     Ok((mesh, stats))
 }
 
+/// A fill with seeds over the front: the tetrahedra, how many seeds are in place, the seeds
+/// given, the mesher's crashes and the guide it ran with last.
+struct SeededFill {
+    tets: CoreTets,
+    seeds_used: usize,
+    seeds: seeds::Seeds,
+    crashes: usize,
+    guide: CoreGuide,
+}
+
 /// Run the mesher with the seeds over the front's last layer `front`; when it crashes on them
 /// (TetGen aborts on a failed assertion, seen on the ONERA M6 with seeds over the ramps between
-/// stacks), again with the seeds over the prisms only (`on_prisms`), then with none. Returns
-/// the tetrahedra, the seeds in place, the seeds given and the crashes.
+/// stacks), again with the seeds over the prisms only (`on_prisms`), then with none.
 fn fill_with_seeds(
     mesher: &dyn CoreMesher,
     boundary: &ClosedBoundary,
     front: &FrontLayer,
     on_prisms: impl FnOnce() -> FrontLayer,
-) -> Result<(CoreTets, usize, seeds::Seeds, usize), FillError> {
+) -> Result<SeededFill, FillError> {
     let mut next = Some(on_prisms);
     let mut layer = std::borrow::Cow::Borrowed(front);
     let mut crashes = 0;
     let candidates = loop {
-        let (guide, seeds) = CoreGuide::with_seeds(boundary, &layer);
-        let signal = match fill_keeping_boundary(mesher, boundary, guide) {
+        let (mut guide, seeds) = CoreGuide::with_seeds(boundary, &layer);
+        let signal = match fill_keeping_boundary(mesher, boundary, &mut guide) {
             Err(FillError::TetGenCrashed { signal }) => signal,
-            result => return result.map(|(tets, used)| (tets, used, seeds, crashes)),
+            result => {
+                return result.map(|(tets, seeds_used)| SeededFill {
+                    tets,
+                    seeds_used,
+                    seeds,
+                    crashes,
+                    guide,
+                })
+            }
         };
         crashes += 1;
         let Some(on_prisms) = next.take() else {
@@ -475,8 +525,10 @@ fn fill_with_seeds(
         tracing::warn!(signal, "TetGen crashed: again with the seeds over the prisms only");
         layer = std::borrow::Cow::Owned(on_prisms());
     };
-    let (tets, _) = fill_keeping_boundary(mesher, boundary, CoreGuide::mean_edge_length(boundary))?;
-    Ok((tets, 0, seeds::Seeds { candidates, ..Default::default() }, crashes))
+    let mut guide = CoreGuide::mean_edge_length(boundary);
+    let (tets, _) = fill_keeping_boundary(mesher, boundary, &mut guide)?;
+    let seeds = seeds::Seeds { candidates, ..Default::default() };
+    Ok(SeededFill { tets, seeds_used: 0, seeds, crashes, guide })
 }
 
 /// Times the mesher is run again, with the seeds near the boundary triangle it lost removed,
@@ -494,14 +546,14 @@ const SEED_CLEARING: f64 = 3.0;
 fn fill_keeping_boundary(
     mesher: &dyn CoreMesher,
     boundary: &ClosedBoundary,
-    mut guide: CoreGuide,
+    guide: &mut CoreGuide,
 ) -> Result<(CoreTets, usize), FillError> {
     let n = boundary.points.len();
     let mut attempt = 0;
     loop {
-        let mut tets = mesher.fill(boundary, &guide)?;
+        let mut tets = mesher.fill(boundary, guide)?;
         merge::drop_unused_points(&mut tets, n);
-        let seeds_used = merge::seeds_in_place_first(boundary, &guide, &mut tets);
+        let seeds_used = merge::seeds_in_place_first(boundary, guide, &mut tets);
         let lost = match merge::check_boundary_kept(boundary, &tets) {
             Ok(()) => return Ok((tets, seeds_used)),
             Err(FillError::BoundaryNotKept { triangle, .. }) if !guide.interior.is_empty() => triangle,

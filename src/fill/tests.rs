@@ -234,12 +234,12 @@ fn a_lost_boundary_triangle_is_retried_without_the_seeds_near_it() {
     guide.size.push(1.0);
     let mesher = LosesTriangleNearSeeds { tet, always: false };
     let (tets, seeds_used) =
-        fill_keeping_boundary(&mesher, &boundary, guide.clone()).expect("the retry keeps it");
+        fill_keeping_boundary(&mesher, &boundary, &mut guide.clone()).expect("the retry keeps it");
     assert_eq!((tets.tets.len(), seeds_used, tets.points.len()), (1, 0, 4));
     // A mesher that loses it whatever the seeds: an error, after the retries.
     let stubborn = LosesTriangleNearSeeds { tet, always: true };
     assert!(matches!(
-        fill_keeping_boundary(&stubborn, &boundary, guide),
+        fill_keeping_boundary(&stubborn, &boundary, &mut guide),
         Err(FillError::BoundaryNotKept { triangle: 0, .. })
     ));
 }
@@ -248,7 +248,7 @@ fn a_lost_boundary_triangle_is_retried_without_the_seeds_near_it() {
 fn seeds_still_in_place_come_first_after_the_boundary() {
     let (boundary, _) = one_tetrahedron(1.0);
     let seeds = [DVec3::splat(0.1), DVec3::splat(0.2), DVec3::splat(0.15)];
-    let guide = CoreGuide { interior: seeds.to_vec(), size: Vec::new() };
+    let guide = CoreGuide { interior: seeds.to_vec(), ..Default::default() };
     // The mesher moved the first seed, added a point of its own first, and kept the others.
     let moved = DVec3::splat(0.11);
     let own = DVec3::new(0.2, 0.1, 0.1);
@@ -263,6 +263,10 @@ fn seeds_still_in_place_come_first_after_the_boundary() {
     assert_eq!(&core.points[..4], &boundary.points[..]);
     let after: Vec<[DVec3; 4]> = core.tets.iter().map(|t| t.map(|v| core.points[v as usize])).collect();
     assert_eq!(before, after, "the tetrahedra keep their corners");
+    // The guide's last point only carries a size (a graded fill's): in place, it is no seed.
+    let sizing = CoreGuide { sizing_points: 1, ..guide };
+    assert_eq!(merge::seeds_in_place_first(&boundary, &sizing, &mut core), 1);
+    assert_eq!(core.points[4], seeds[1]);
 }
 
 /// A mesher that crashes (as TetGen aborts on some seed sets) whenever it is given seeds, else
@@ -300,7 +304,7 @@ fn a_mesher_crashing_on_the_seeds_is_run_again_with_fewer_then_none() {
     let front = FrontLayer { heights, steps: vec![DVec3::NAN; boundary.points.len()] };
     assert!(!CoreGuide::with_seeds(&boundary, &front).1.points.is_empty(), "there are seeds to crash on");
     let mesher = CrashesOnSeeds { runs: std::cell::Cell::new(0) };
-    let (tets, used, seeds, crashes) =
+    let SeededFill { tets, seeds_used: used, seeds, crashes, .. } =
         fill_with_seeds(&mesher, &boundary, &front, || front.clone()).expect("no seeds at last");
     assert_eq!((used, seeds.points.len(), mesher.runs.get(), crashes), (0, 0, 3, 2));
     assert!(seeds.candidates > 0, "the candidates are still reported");
@@ -319,4 +323,51 @@ fn a_moved_mesh_boundary_point_is_an_error() {
     tets.points[3].z += 1e-3;
     let err = merge::check_mesh_boundary_kept(&core, &nodes, &tets).expect_err("a wall point moved");
     assert!(err.to_string().contains(&format!("node {}", nodes[3])), "{err}");
+}
+
+/// Points on a line, each edge to the next three (tetrahedra over four consecutive points):
+/// the sizes grow from the fine end by the gradation along the path, up to the coarse end's size
+/// or `max_size`.
+#[test]
+fn graded_sizes_grow_by_the_gradation_from_the_boundary() {
+    let points: Vec<DVec3> = (0..41).map(|i| DVec3::new(i as f64 * 0.5, 0.0, 0.0)).collect();
+    // Boundary points first: the fine end (size 0.1) and the coarse end (size 2).
+    let order: Vec<usize> = [0, 40].into_iter().chain(1..40).collect();
+    let core = CoreTets {
+        points: order.iter().map(|&i| points[i]).collect(),
+        tets: (0..38)
+            .map(|i| [i, i + 1, i + 2, i + 3].map(|k| order.iter().position(|&o| o == k).unwrap() as u32))
+            .collect(),
+        boundary_steiner_points: 0,
+    };
+    let sizing = |gradation, max_size| grading::CoreSizing { gradation, max_size, regions: Vec::new() };
+    let size = grading::graded_sizes(&core, &[0.1, 2.0], &sizing(1.2, None));
+    for (p, s) in core.points.iter().zip(&size) {
+        let expected = (0.1 + 0.2 * p.x).min(2.0 + 0.2 * (20.0 - p.x)).min(2.0);
+        assert!((s - expected).abs() < 1e-12, "at x = {}: {s} vs {expected}", p.x);
+    }
+    let capped = grading::graded_sizes(&core, &[0.1, 2.0], &sizing(1.2, Some(1.0)));
+    assert!(capped.iter().skip(2).all(|&s| s <= 1.0 + 1e-12), "{capped:?}");
+    assert_eq!(capped[1], 2.0, "a boundary size stays as given");
+    // A steeper gradation reaches the cap sooner.
+    let steep = grading::graded_sizes(&core, &[0.1, 2.0], &sizing(1.5, None));
+    assert!(steep.iter().zip(&size).all(|(a, b)| a >= b), "sizes only grow with the gradation");
+}
+
+/// The graded fill keeps the mesher's seeds as seeds and its other points as sizing points
+/// only: a mesher that loses a boundary triangle on the second fill leaves the first.
+#[test]
+fn a_graded_fill_that_loses_the_boundary_keeps_the_first() {
+    let (boundary, tet) = one_tetrahedron(30.0);
+    let first = CoreTets { points: boundary.points.clone(), tets: vec![tet], boundary_steiner_points: 0 };
+    let guide = CoreGuide::mean_edge_length(&boundary);
+    let stubborn = LosesTriangleNearSeeds { tet, always: true };
+    let sizing = grading::CoreSizing::default();
+    let (tets, used, graded) =
+        grading::fill_graded(&stubborn, &boundary, first.clone(), 0, guide.clone(), &sizing);
+    assert!(!graded.graded && used == 0 && tets.tets == first.tets);
+    let fine = LosesTriangleNearSeeds { tet, always: false };
+    let (tets, _, graded) = grading::fill_graded(&fine, &boundary, first, 0, guide, &sizing);
+    assert!(graded.graded);
+    merge::check_boundary_kept(&boundary, &tets).expect("kept");
 }

@@ -583,7 +583,7 @@ fn front_sizes(points: &[DVec3], columns: &Columns, front: &Front) -> Vec<f64> {
         front.neighbours(c, out);
         out.extend(siblings(c));
     };
-    super::graded_minimum(&mut size, neighbours, ratio);
+    crate::sizing::graded_minimum(&mut size, neighbours, |v, w, x| x * ratio(v, w));
     size
 }
 

@@ -331,45 +331,14 @@ fn grade_first_heights(surface: &Surface, columns: &front::Columns, column_spec:
         }
     }
     // A little under r: the thickness of curved fronts varies a little more than h0.
-    graded_minimum(
+    crate::sizing::graded_minimum(
         &mut height,
         |v, out| out.extend(neighbours[v].iter().map(|&w| w as usize)),
-        |v, w| growth[w].min(growth[v]).powf(GRADING_SHARE),
+        |v, w, h| h * growth[w].min(growth[v]).powf(GRADING_SHARE),
     );
     for (c, spec) in column_spec.iter_mut().enumerate() {
         if let Some(s) = spec {
             s.first_height = s.first_height.min(height[columns.wall_vertex[c] as usize]);
-        }
-    }
-}
-
-/// Lower `values` so that no value exceeds a neighbour's times `ratio(neighbour, it)`: the
-/// largest such field under the given one (a graded minimum, by Dijkstra's order: smallest
-/// first). Values that are not finite stay as they are and constrain nothing.
-/// `neighbours(v, out)` appends the neighbours of `v` to `out`.
-pub(crate) fn graded_minimum(
-    values: &mut [f64],
-    neighbours: impl Fn(usize, &mut Vec<usize>),
-    ratio: impl Fn(usize, usize) -> f64,
-) {
-    use std::cmp::Reverse;
-    let mut heap: std::collections::BinaryHeap<Reverse<(u64, usize)>> = (0..values.len())
-        .filter(|&v| values[v].is_finite() && values[v] >= 0.0)
-        .map(|v| Reverse((values[v].to_bits(), v)))
-        .collect();
-    let mut around = Vec::new();
-    while let Some(Reverse((bits, v))) = heap.pop() {
-        if f64::from_bits(bits) > values[v] {
-            continue;
-        }
-        around.clear();
-        neighbours(v, &mut around);
-        for &w in &around {
-            let limit = values[v] * ratio(v, w);
-            if values[w].is_finite() && limit < values[w] {
-                values[w] = limit;
-                heap.push(Reverse((limit.to_bits(), w)));
-            }
         }
     }
 }

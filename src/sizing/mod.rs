@@ -248,5 +248,37 @@ fn check_wall(wall: &Surface) -> Result<(), SpecError> {
     }
 }
 
+/// Lower `values` over a graph so that no value exceeds `limit(neighbour, it, neighbour's
+/// value)` (a growth ratio: `x * r`; a gradation: `x + (g - 1) * length`): the largest such
+/// field under the given one (a graded minimum, by Dijkstra's order: smallest first; `limit`
+/// must not be below its value argument). Values that are not finite stay as they are and
+/// constrain nothing. `neighbours(v, out)` appends the neighbours of `v` to `out`.
+pub fn graded_minimum(
+    values: &mut [f64],
+    neighbours: impl Fn(usize, &mut Vec<usize>),
+    limit: impl Fn(usize, usize, f64) -> f64,
+) {
+    use std::cmp::Reverse;
+    let mut heap: std::collections::BinaryHeap<Reverse<(u64, usize)>> = (0..values.len())
+        .filter(|&v| values[v].is_finite() && values[v] >= 0.0)
+        .map(|v| Reverse((values[v].to_bits(), v)))
+        .collect();
+    let mut around = Vec::new();
+    while let Some(Reverse((bits, v))) = heap.pop() {
+        if f64::from_bits(bits) > values[v] {
+            continue;
+        }
+        around.clear();
+        neighbours(v, &mut around);
+        for &w in &around {
+            let limit = limit(v, w, values[v]);
+            if values[w].is_finite() && limit < values[w] {
+                values[w] = limit;
+                heap.push(Reverse((limit.to_bits(), w)));
+            }
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests;
