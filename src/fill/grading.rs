@@ -13,6 +13,7 @@
 use serde::Serialize;
 
 use super::{merge, ClosedBoundary, CoreGuide, CoreMesher, CoreTets};
+use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::DVec3;
 use crate::sizing::Region;
 
@@ -21,6 +22,11 @@ const MAX_REGION_POINTS: usize = 2_000_000;
 
 /// Region points are sampled this many region sizes apart (the mesher refines between them).
 const REGION_SPACING: f64 = 2.0;
+
+/// When the second fill fails (TetGen aborted on the elbow at growth 1.1999), it is run again
+/// with the first fill's points only where they are at least this many of their sizes away
+/// from the boundary (the front's sizes hold near it anyway).
+const RETRY_CLEARANCE: f64 = 1.0;
 
 /// What the core's sizes follow beyond the boundary's.
 #[derive(Clone, Debug, PartialEq, Serialize)]
@@ -59,7 +65,8 @@ pub struct Graded {
 
 /// Fill again with the graded sizes; `first` is the first fill (`seeds_used` seeds in place,
 /// run with `guide`). Returns the tetrahedra, the seeds in place and what was done: where the
-/// second fill fails or loses a boundary triangle, the first stays (a warning says so).
+/// second fill fails or loses a boundary triangle, even with the points near the boundary left
+/// out ([`RETRY_CLEARANCE`]), the first stays (a warning says so).
 pub(super) fn fill_graded(
     mesher: &dyn CoreMesher,
     boundary: &ClosedBoundary,
@@ -72,26 +79,44 @@ pub(super) fn fill_graded(
     if guide.size.len() < n {
         return (first, seeds_used, Graded::default());
     }
-    let mut size = graded_sizes(&first, &guide.size[..n], sizing);
+    let size = graded_sizes(&first, &guide.size[..n], sizing);
     let regions = region_points(&first, n, &size, sizing);
-    guide.interior = first.points[n..].to_vec();
-    guide.interior.extend(regions.iter().map(|r| r.0));
-    size.extend(regions.iter().map(|r| r.1));
-    guide.size = size;
-    guide.sizing_points = guide.interior.len() - seeds_used;
-    let second = mesher.fill(boundary, &guide).and_then(|mut tets| {
-        merge::drop_unused_points(&mut tets, n);
-        let used = merge::seeds_in_place_first(boundary, &guide, &mut tets);
-        merge::check_boundary_kept(boundary, &tets).map(|()| (tets, used))
-    });
     let region_points = regions.len();
-    match second {
-        Ok((tets, used)) => (tets, used, Graded { graded: true, region_points }),
-        Err(e) => {
-            tracing::warn!(error = %e, "the graded fill failed: the core keeps the mesher's own sizes");
-            (first, seeds_used, Graded { graded: false, region_points })
+    let bvh =
+        TriangleBvh::new(boundary.triangles.iter().map(|t| t.map(|v| boundary.points[v as usize])).collect());
+    let mut error = None;
+    for clearance in [None, Some(RETRY_CLEARANCE)] {
+        // The seeds in place, then the first fill's other points (those clear of the boundary
+        // on the retry), then the regions'.
+        let kept: Vec<usize> = (n..first.points.len())
+            .filter(|&i| {
+                i < n + seeds_used
+                    || clearance.is_none_or(|c| {
+                        bvh.nearest(first.points[i]).is_none_or(|near| near.distance >= c * size[i])
+                    })
+            })
+            .collect();
+        guide.interior = kept.iter().map(|&i| first.points[i]).chain(regions.iter().map(|r| r.0)).collect();
+        guide.size = size[..n].iter().chain(kept.iter().map(|&i| &size[i])).copied().collect();
+        guide.size.extend(regions.iter().map(|r| r.1));
+        guide.sizing_points = guide.interior.len() - seeds_used;
+        let second = mesher.fill(boundary, &guide).and_then(|mut tets| {
+            merge::drop_unused_points(&mut tets, n);
+            let used = merge::seeds_in_place_first(boundary, &guide, &mut tets);
+            merge::check_boundary_kept(boundary, &tets).map(|()| (tets, used))
+        });
+        match second {
+            Ok((tets, used)) => return (tets, used, Graded { graded: true, region_points }),
+            Err(e) => {
+                tracing::info!(error = %e, ?clearance, "the graded fill failed");
+                error = Some(e);
+            }
         }
     }
+    if let Some(e) = error {
+        tracing::warn!(error = %e, "the graded fill failed: the core keeps the mesher's own sizes");
+    }
+    (first, seeds_used, Graded { graded: false, region_points })
 }
 
 /// The sizes at the points of `mesh` graded from `boundary_size` (at its first points) and the

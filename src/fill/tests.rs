@@ -354,8 +354,8 @@ fn graded_sizes_grow_by_the_gradation_from_the_boundary() {
     assert!(steep.iter().zip(&size).all(|(a, b)| a >= b), "sizes only grow with the gradation");
 }
 
-/// The graded fill keeps the mesher's seeds as seeds and its other points as sizing points
-/// only: a mesher that loses a boundary triangle on the second fill leaves the first.
+/// A mesher that loses a boundary triangle on the second fill whatever it is given leaves the
+/// first; one that loses it on a point near the boundary takes the retry without it.
 #[test]
 fn a_graded_fill_that_loses_the_boundary_keeps_the_first() {
     let (boundary, tet) = one_tetrahedron(30.0);
@@ -367,7 +367,15 @@ fn a_graded_fill_that_loses_the_boundary_keeps_the_first() {
         grading::fill_graded(&stubborn, &boundary, first.clone(), 0, guide.clone(), &sizing);
     assert!(!graded.graded && used == 0 && tets.tets == first.tets);
     let fine = LosesTriangleNearSeeds { tet, always: false };
-    let (tets, _, graded) = grading::fill_graded(&fine, &boundary, first, 0, guide, &sizing);
+    let (tets, _, graded) = grading::fill_graded(&fine, &boundary, first.clone(), 0, guide.clone(), &sizing);
     assert!(graded.graded);
+    merge::check_boundary_kept(&boundary, &tets).expect("kept");
+    // A point of the first fill close to triangle 0 makes the second lose it: the retry leaves
+    // the points near the boundary out.
+    let [a, b, c] = boundary.triangles[0].map(|v| boundary.points[v as usize]);
+    let near = (a + b + c) / 3.0 + 0.5 * triangle_area_vector(a, b, c).normalize();
+    let with_near = CoreTets { points: [first.points.clone(), vec![near]].concat(), ..first };
+    let (tets, _, graded) = grading::fill_graded(&fine, &boundary, with_near, 0, guide, &sizing);
+    assert!(graded.graded, "the retry without the point takes");
     merge::check_boundary_kept(&boundary, &tets).expect("kept");
 }
