@@ -489,9 +489,17 @@ impl std::fmt::Display for MeshReport {
                     }
                     (None, _) => "TetGen's own sizes".to_owned(),
                 };
+                let r = &c.size_ratio;
                 writeln!(
                     f,
-                    "          {sizes}; {} seeds over the front in place (of {} front vertices with a last layer under them)",
+                    "          {sizes}: neighbouring points' sizes median {:.2}, p95 {:.2} apart ({:.1}% within the gradation)",
+                    r.median,
+                    r.p95,
+                    100.0 * r.within_band
+                )?;
+                writeln!(
+                    f,
+                    "          {} seeds over the front in place (of {} front vertices with a last layer under them)",
                     c.seeds, c.seed_candidates
                 )?;
                 if c.mesher_crashes > 0 {

@@ -187,8 +187,11 @@ fn the_core_sizes_grow_by_the_gradation() {
     let (mesh, _) = fill_core(&layers, &wall, &graded).expect("fills");
     let growth = core_edge_growth(&mesh, front_edge, thickness);
     let own = CoreOptions { sizing: None, ..Default::default() };
+    let graded_ratio = stats.size_ratio.p95;
     let (ungraded, stats) = fill_core(&layers, &wall, &own).expect("fills");
     assert_eq!(stats.gradation, None);
+    // The report says so too: neighbouring points' sizes closer.
+    assert!(graded_ratio < stats.size_ratio.p95, "{graded_ratio} vs {:?}", stats.size_ratio);
     let ungraded_growth = core_edge_growth(&ungraded, front_edge, thickness);
     eprintln!("edge over graded size, 90th percentile: {growth:.2} graded, {ungraded_growth:.2} not");
     // TetGen bounds circumradii (1.2 sizes), and a tetrahedron's edges reach 1.6 of its circumradius.

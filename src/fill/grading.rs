@@ -12,6 +12,8 @@
 
 use serde::Serialize;
 
+use crate::layers::smoothness::RatioStats;
+
 use super::{merge, ClosedBoundary, CoreGuide, CoreMesher, CoreTets};
 use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::DVec3;
@@ -202,4 +204,30 @@ pub(super) fn region_points(
         }
     }
     out
+}
+
+/// How smoothly the sizes of `tets` grow: over every edge, the larger of its two ends' sizes
+/// (the mean length of the edges at a point) over the smaller, counted within `[1, gradation]`.
+/// TetGen's own sizes: spot's 95th percentile 1.74, the elbow's 5.4; graded by 1.2: 1.46, 2.5.
+pub fn size_ratio_across_edges(points: &[DVec3], tets: &[[u32; 4]], gradation: f64) -> RatioStats {
+    let mut edges: Vec<[u32; 2]> = tets
+        .iter()
+        .flat_map(|t| {
+            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
+                .map(|(i, j)| crate::mesh::sorted_edge(t[i], t[j]))
+        })
+        .collect();
+    edges.sort_unstable();
+    edges.dedup();
+    let mut sum = vec![(0.0, 0usize); points.len()];
+    for &[a, b] in &edges {
+        let length = points[a as usize].distance(points[b as usize]);
+        for v in [a, b] {
+            let (total, count) = &mut sum[v as usize];
+            (*total, *count) = (*total + length, *count + 1);
+        }
+    }
+    let size = |v: u32| sum[v as usize].0 / sum[v as usize].1 as f64;
+    let ratios = edges.iter().map(|&[a, b]| size(a).max(size(b)) / size(a).min(size(b))).collect();
+    RatioStats::of(ratios, 1.0, gradation)
 }

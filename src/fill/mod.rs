@@ -363,6 +363,8 @@ pub struct CoreStats {
     pub gradation: Option<f64>,
     /// Points sampled in the refinement regions for the mesher ([`grading::region_points`]).
     pub region_points: usize,
+    /// How smoothly the core's sizes grow ([`grading::size_ratio_across_edges`]).
+    pub size_ratio: crate::layers::smoothness::RatioStats,
     /// Smallest and largest dihedral angle of the core tetrahedra, degrees.
     pub min_dihedral: f64,
     pub max_dihedral: f64,
@@ -467,6 +469,8 @@ pub fn fill_core_with_symmetry(
         &options.improve,
     );
     merge::check_boundary_kept(&boundary, &tets)?;
+    let gradation = options.sizing.as_ref().map_or(crate::sizing::DEFAULT_GRADATION, |s| s.gradation);
+    let size_ratio = grading::size_ratio_across_edges(&tets.points, &tets.tets, gradation);
     merge::check_mesh_boundary_kept(&core, &nodes, &tets)?;
     let (mesh, mut stats) = merge::merge(core, &nodes, &tets);
     stats.quality = quality;
@@ -475,6 +479,7 @@ pub fn fill_core_with_symmetry(
     stats.mesher_crashes = mesher_crashes;
     stats.gradation = options.sizing.as_ref().filter(|_| graded.graded).map(|s| s.gradation);
     stats.region_points = graded.region_points;
+    stats.size_ratio = size_ratio;
     stats.boundary_steiner_points = tets.boundary_steiner_points;
     stats.mesher_seconds = mesher_seconds;
     stats.seconds = start.elapsed().as_secs_f64();

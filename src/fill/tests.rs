@@ -379,3 +379,23 @@ fn a_graded_fill_that_loses_the_boundary_keeps_the_first() {
     assert!(graded.graded, "the retry without the point takes");
     merge::check_boundary_kept(&boundary, &tets).expect("kept");
 }
+
+/// The sizes of a regular tetrahedron's corners are alike; a second, twice as large on a face of
+/// it, makes the edges between the two apart.
+#[test]
+fn size_ratios_across_edges_are_one_on_equal_cells_and_more_where_sizes_change() {
+    let (boundary, tet) = one_tetrahedron(1.0);
+    let regular = [
+        DVec3::new(1.0, 1.0, 1.0),
+        DVec3::new(1.0, -1.0, -1.0),
+        DVec3::new(-1.0, 1.0, -1.0),
+        DVec3::new(-1.0, -1.0, 1.0),
+    ];
+    let one = grading::size_ratio_across_edges(&regular, &[[0, 1, 2, 3]], 1.2);
+    assert_eq!((one.count, one.max, one.within_band), (6, 1.0, 1.0));
+    let mut points = boundary.points.clone();
+    points.push(DVec3::splat(-2.0));
+    let two = grading::size_ratio_across_edges(&points, &[tet, [1, 2, 3, 4]], 1.2);
+    assert_eq!(two.count, 9);
+    assert!(two.max > 1.2 && two.within_band < 1.0, "{two:?}");
+}
