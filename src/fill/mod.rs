@@ -186,8 +186,9 @@ fn sorted_triangle(mut t: [u32; 3]) -> [u32; 3] {
 }
 
 /// What the mesher gets besides the boundary: points it must keep inside the region (the
-/// [`seeds`] over the front) and the target edge length at every boundary point and then every
-/// interior point; the mesher grades the sizes in between.
+/// [`seeds`] over the front, and on a graded fill the first fill's points, which carry the
+/// graded sizes) and the target edge length at every boundary point and then every interior
+/// point; the mesher interpolates the sizes in between.
 #[derive(Clone, Debug, Default)]
 pub struct CoreGuide {
     /// The seeds, then `sizing_points` points that only carry sizes inside.
