@@ -14,10 +14,14 @@ use serde::Serialize;
 
 use crate::layers::smoothness::RatioStats;
 
-use super::{merge, ClosedBoundary, CoreGuide, CoreMesher, CoreTets};
+use super::{merge, ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
 use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::DVec3;
 use crate::sizing::Region;
+
+/// The most core tetrahedra the graded sizes may ask for: more (a maximum size far below the
+/// farfield's, say) is an error that names the sizes, not hours of meshing.
+pub const MAX_CORE_TETRAHEDRA: f64 = 5.0e7;
 
 /// Points sampled in the refinement regions at most (a warning says when they are cut short).
 const MAX_REGION_POINTS: usize = 2_000_000;
@@ -76,12 +80,23 @@ pub(super) fn fill_graded(
     seeds_used: usize,
     mut guide: CoreGuide,
     sizing: &CoreSizing,
-) -> (CoreTets, usize, Graded) {
+) -> Result<(CoreTets, usize, Graded), FillError> {
     let n = boundary.points.len();
     if guide.size.len() < n {
-        return (first, seeds_used, Graded::default());
+        return Ok((first, seeds_used, Graded::default()));
     }
     let size = graded_sizes(&first, &guide.size[..n], sizing);
+    let expected = expected_tetrahedra(&first, &size);
+    tracing::debug!(expected, "tetrahedra the graded sizes ask for");
+    if expected > MAX_CORE_TETRAHEDRA {
+        return Err(FillError::Options(format!(
+            "the core's sizes ask for about {:.0} million tetrahedra (at most {:.0} million): raise \
+             [sizing] max_size ({}) or the regions' sizes, or make the farfield smaller",
+            expected / 1e6,
+            MAX_CORE_TETRAHEDRA / 1e6,
+            sizing.max_size.map_or("none".to_owned(), |m| m.to_string())
+        )));
+    }
     let regions = region_points(&first, n, &size, sizing);
     let region_points = regions.len();
     let bvh =
@@ -108,7 +123,7 @@ pub(super) fn fill_graded(
             merge::check_boundary_kept(boundary, &tets).map(|()| (tets, used))
         });
         match second {
-            Ok((tets, used)) => return (tets, used, Graded { graded: true, region_points }),
+            Ok((tets, used)) => return Ok((tets, used, Graded { graded: true, region_points })),
             Err(e) => {
                 tracing::info!(error = %e, ?clearance, "the graded fill failed");
                 error = Some(e);
@@ -118,7 +133,22 @@ pub(super) fn fill_graded(
     if let Some(e) = error {
         tracing::warn!(error = %e, "the graded fill failed: the core keeps the mesher's own sizes");
     }
-    (first, seeds_used, Graded { graded: false, region_points })
+    Ok((first, seeds_used, Graded { graded: false, region_points }))
+}
+
+/// How many tetrahedra `size` (at the points of `mesh`) asks for: over the tetrahedra of
+/// `mesh`, their volume over that of a regular tetrahedron whose edge is their corners' mean
+/// size.
+fn expected_tetrahedra(mesh: &CoreTets, size: &[f64]) -> f64 {
+    mesh.tets
+        .iter()
+        .map(|t| {
+            let [a, b, c, d] = t.map(|v| mesh.points[v as usize]);
+            let volume = (b - a).cross(c - a).dot(d - a).abs() / 6.0;
+            let edge = t.iter().map(|&v| size[v as usize]).sum::<f64>() / 4.0;
+            volume / (edge.powi(3) / (6.0 * std::f64::consts::SQRT_2))
+        })
+        .sum()
 }
 
 /// The sizes at the points of `mesh` graded from `boundary_size` (at its first points) and the

@@ -454,7 +454,7 @@ pub fn fill_core_with_symmetry(
         SeededFill { tets, seeds_used: 0, seeds: seeds::Seeds::default(), crashes: 0, guide }
     };
     let (tets, seeds_used, graded) = match &options.sizing {
-        Some(sizing) => grading::fill_graded(mesher, &boundary, tets, seeds_used, guide, sizing),
+        Some(sizing) => grading::fill_graded(mesher, &boundary, tets, seeds_used, guide, sizing)?,
         None => (tets, seeds_used, grading::Graded::default()),
     };
     let mesher_seconds = mesher_start.elapsed().as_secs_f64();

@@ -364,20 +364,26 @@ fn a_graded_fill_that_loses_the_boundary_keeps_the_first() {
     let stubborn = LosesTriangleNearSeeds { tet, always: true };
     let sizing = grading::CoreSizing::default();
     let (tets, used, graded) =
-        grading::fill_graded(&stubborn, &boundary, first.clone(), 0, guide.clone(), &sizing);
+        grading::fill_graded(&stubborn, &boundary, first.clone(), 0, guide.clone(), &sizing).unwrap();
     assert!(!graded.graded && used == 0 && tets.tets == first.tets);
     let fine = LosesTriangleNearSeeds { tet, always: false };
-    let (tets, _, graded) = grading::fill_graded(&fine, &boundary, first.clone(), 0, guide.clone(), &sizing);
+    let (tets, _, graded) =
+        grading::fill_graded(&fine, &boundary, first.clone(), 0, guide.clone(), &sizing).unwrap();
     assert!(graded.graded);
     merge::check_boundary_kept(&boundary, &tets).expect("kept");
     // A point of the first fill close to triangle 0 makes the second lose it: the retry leaves
     // the points near the boundary out.
     let [a, b, c] = boundary.triangles[0].map(|v| boundary.points[v as usize]);
     let near = (a + b + c) / 3.0 + 0.5 * triangle_area_vector(a, b, c).normalize();
-    let with_near = CoreTets { points: [first.points.clone(), vec![near]].concat(), ..first };
-    let (tets, _, graded) = grading::fill_graded(&fine, &boundary, with_near, 0, guide, &sizing);
+    let with_near = CoreTets { points: [first.points.clone(), vec![near]].concat(), ..first.clone() };
+    let (tets, _, graded) =
+        grading::fill_graded(&fine, &boundary, with_near, 0, guide.clone(), &sizing).unwrap();
     assert!(graded.graded, "the retry without the point takes");
     merge::check_boundary_kept(&boundary, &tets).expect("kept");
+    // Sizes a thousand times finer than the tetrahedron (10^9 tetrahedra) are an error.
+    let tiny = CoreGuide { size: vec![0.03; 4], ..guide };
+    let e = grading::fill_graded(&fine, &boundary, first, 0, tiny, &sizing).unwrap_err();
+    assert!(matches!(e, FillError::Options(_)) && e.to_string().contains("max_size"), "{e}");
 }
 
 /// The sizes of a regular tetrahedron's corners are alike; a second, twice as large on a face of
