@@ -14,9 +14,10 @@ use serde::Serialize;
 
 use crate::layers::smoothness::RatioStats;
 
+use super::improve::TET_EDGES;
 use super::{merge, ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
 use crate::geometry::bvh::TriangleBvh;
-use crate::geometry::DVec3;
+use crate::geometry::{tet_signed_volume, DVec3};
 use crate::sizing::Region;
 
 /// The most core tetrahedra the graded sizes may ask for: more (a maximum size far below the
@@ -54,9 +55,7 @@ impl Default for CoreSizing {
 impl CoreSizing {
     /// The user's size at `p`: the regions' graded away from them, the maximum size.
     fn user_size(&self, p: DVec3) -> f64 {
-        let slope = self.gradation - 1.0;
-        let max = self.max_size.unwrap_or(f64::INFINITY);
-        self.regions.iter().map(|r| r.size() + slope * r.distance(p)).fold(max, f64::min)
+        crate::sizing::region_size(&self.regions, self.gradation, self.max_size.unwrap_or(f64::INFINITY), p)
     }
 }
 
@@ -99,8 +98,15 @@ pub(super) fn fill_graded(
     }
     let regions = region_points(&first, n, &size, sizing);
     let region_points = regions.len();
-    let bvh =
-        TriangleBvh::new(boundary.triangles.iter().map(|t| t.map(|v| boundary.points[v as usize])).collect());
+    // Built for the retry only.
+    let bvh = std::cell::OnceCell::new();
+    let boundary_bvh = || {
+        bvh.get_or_init(|| {
+            TriangleBvh::new(
+                boundary.triangles.iter().map(|t| t.map(|v| boundary.points[v as usize])).collect(),
+            )
+        })
+    };
     let mut error = None;
     for clearance in [None, Some(RETRY_CLEARANCE)] {
         // The seeds in place, then the first fill's other points (those clear of the boundary
@@ -109,7 +115,9 @@ pub(super) fn fill_graded(
             .filter(|&i| {
                 i < n + seeds_used
                     || clearance.is_none_or(|c| {
-                        bvh.nearest(first.points[i]).is_none_or(|near| near.distance >= c * size[i])
+                        boundary_bvh()
+                            .nearest(first.points[i])
+                            .is_none_or(|near| near.distance >= c * size[i])
                     })
             })
             .collect();
@@ -144,7 +152,7 @@ fn expected_tetrahedra(mesh: &CoreTets, size: &[f64]) -> f64 {
         .iter()
         .map(|t| {
             let [a, b, c, d] = t.map(|v| mesh.points[v as usize]);
-            let volume = (b - a).cross(c - a).dot(d - a).abs() / 6.0;
+            let volume = tet_signed_volume(a, b, c, d).abs();
             let edge = t.iter().map(|&v| size[v as usize]).sum::<f64>() / 4.0;
             volume / (edge.powi(3) / (6.0 * std::f64::consts::SQRT_2))
         })
@@ -163,7 +171,7 @@ pub(super) fn graded_sizes(mesh: &CoreTets, boundary_size: &[f64], sizing: &Core
     size[..boundary_size.len()].copy_from_slice(boundary_size);
     let mut neighbours: Vec<Vec<u32>> = vec![Vec::new(); mesh.points.len()];
     for t in &mesh.tets {
-        for (i, j) in [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)] {
+        for (i, j) in TET_EDGES {
             neighbours[t[i] as usize].push(t[j]);
             neighbours[t[j] as usize].push(t[i]);
         }
@@ -181,8 +189,8 @@ pub(super) fn graded_sizes(mesh: &CoreTets, boundary_size: &[f64], sizing: &Core
 
 /// Points (with their sizes) inside the tetrahedra of `mesh` that a refinement region wants
 /// finer than they are: on a lattice [`REGION_SPACING`] sizes apart (the size at the
-/// tetrahedron's centre), where the region's size is less than half its longest edge, sized by the least of the region's
-/// size and the corners' graded `size`. Only tetrahedra with no corner among the first
+/// tetrahedron's centre), where the region's size is less than half its longest edge, sized by
+/// the least of the region's size and the corners' graded `size`. Only tetrahedra with no corner among the first
 /// `boundary` points (the front's and the farfield's) are sampled: no point comes near the
 /// boundary.
 pub(super) fn region_points(
@@ -197,10 +205,7 @@ pub(super) fn region_points(
     }
     for tet in mesh.tets.iter().filter(|t| t.iter().all(|&v| v as usize >= boundary)) {
         let x = tet.map(|v| mesh.points[v as usize]);
-        let longest = (0..4)
-            .flat_map(|i| (i + 1..4).map(move |j| (i, j)))
-            .map(|(i, j)| x[i].distance(x[j]))
-            .fold(0.0, f64::max);
+        let longest = TET_EDGES.iter().map(|&(i, j)| x[i].distance(x[j])).fold(0.0, f64::max);
         let centre = (x[0] + x[1] + x[2] + x[3]) / 4.0;
         // The user's size anywhere in the tetrahedron is at least this.
         if (sizing.user_size(centre) - (sizing.gradation - 1.0) * longest) * 2.0 >= longest {
@@ -240,13 +245,8 @@ pub(super) fn region_points(
 /// (the mean length of the edges at a point) over the smaller, counted within `[1, gradation]`.
 /// TetGen's own sizes: spot's 95th percentile 1.74, the elbow's 5.4; graded by 1.2: 1.46, 2.5.
 pub fn size_ratio_across_edges(points: &[DVec3], tets: &[[u32; 4]], gradation: f64) -> RatioStats {
-    let mut edges: Vec<[u32; 2]> = tets
-        .iter()
-        .flat_map(|t| {
-            [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)]
-                .map(|(i, j)| crate::mesh::sorted_edge(t[i], t[j]))
-        })
-        .collect();
+    let mut edges: Vec<[u32; 2]> =
+        tets.iter().flat_map(|t| TET_EDGES.map(|(i, j)| crate::mesh::sorted_edge(t[i], t[j]))).collect();
     edges.sort_unstable();
     edges.dedup();
     let mut sum = vec![(0.0, 0usize); points.len()];

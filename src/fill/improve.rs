@@ -50,7 +50,7 @@ static TET_EDGE_FACES: LazyLock<Vec<(usize, usize)>> =
     LazyLock::new(|| edge_face_pairs(CellKind::Tetrahedron));
 
 /// The six edges of a tetrahedron, as local node pairs.
-const TET_EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
+pub(crate) const TET_EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
 
 /// Smallest dihedral angle of tetrahedron `x` in degrees; [`INVALID`] when it is not positive.
 pub fn min_dihedral(x: [DVec3; 4]) -> f64 {

@@ -174,8 +174,7 @@ impl SizingField {
 
     /// The user's isotropic size at `x`: the maximum size, lowered near the refinement regions.
     pub fn user_size(&self, x: DVec3) -> f64 {
-        let slope = self.spec.gradation - 1.0;
-        self.spec.regions.iter().map(|r| r.size() + slope * r.distance(x)).fold(self.spec.max_size, f64::min)
+        region_size(&self.spec.regions, self.spec.gradation, self.spec.max_size, x)
     }
 
     /// Normal and tangential sizes at `x`. The normal size is `h0 + (r - 1) d` at wall distance
@@ -246,6 +245,13 @@ fn check_wall(wall: &Surface) -> Result<(), SpecError> {
         ))),
         None => Ok(()),
     }
+}
+
+/// The size the refinement `regions` want at `x`, graded away from them by `gradation`, and
+/// at most `max_size` (the front's sizing field and the core's share it).
+pub fn region_size(regions: &[Region], gradation: f64, max_size: f64, x: DVec3) -> f64 {
+    let slope = gradation - 1.0;
+    regions.iter().map(|r| r.size() + slope * r.distance(x)).fold(max_size, f64::min)
 }
 
 /// Lower `values` over a graph so that no value exceeds `limit(neighbour, it, neighbour's
