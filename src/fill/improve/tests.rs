@@ -288,11 +288,11 @@ fn a_flip_gives_a_low_first_core_cell_the_last_layers_height() {
     mesh.keep_front_match(HashMap::from([([0, 1, 2], 1.0)]), 1.2);
     let on_front = |mesh: &TetMesh| mesh.tets().find(|t| [0, 1, 2].iter().all(|v| t.contains(v)));
     assert!(on_front(&mesh).unwrap().contains(&3));
-    assert_eq!(mesh.match_front(), 1);
+    assert_eq!(mesh.match_front(MatchInsertion::InBand), 1);
     assert!(on_front(&mesh).unwrap().contains(&4), "the point at the layer's height is its apex");
     assert_consistent(&mesh, &reference);
     assert!(mesh.tets().all(|t| angle_quality(t.map(|v| mesh.points[v as usize])) >= SLIVER_THRESHOLD));
-    assert_eq!(mesh.match_front(), 0, "nothing left to match");
+    assert_eq!(mesh.match_front(MatchInsertion::InBand), 0, "nothing left to match");
 }
 
 /// A front triangle's tetrahedron whose apex is a point the mesher added, 0.4 of the last
@@ -307,7 +307,7 @@ fn an_added_apex_too_low_for_the_last_layer_moves_into_its_band() {
     ];
     let mut mesh = TetMesh::new(points, vec![[0, 1, 2, 3]], 3);
     mesh.keep_front_match(HashMap::from([([0, 1, 2], 1.0)]), 1.2);
-    assert_eq!(mesh.match_front(), 1);
+    assert_eq!(mesh.match_front(MatchInsertion::InBand), 1);
     let apex = mesh.points[3];
     assert!((apex.z - 1.01 / 1.2).abs() < 1e-12, "just into the band: {apex}");
     assert_eq!((apex.x, apex.y), (0.3, 0.3), "along the normal");
@@ -328,4 +328,28 @@ fn mending_a_sliver_keeps_the_first_core_cell_on_the_last_layer_height() {
     assert!(regular.after > matched.after && matched.after >= SLIVER_THRESHOLD);
     let best = mesh.best_improving(vec![regular, matched], Rule::FewerBad).expect("both improve");
     assert_eq!(best.point.map(|p| p.1.z), Some(1.0));
+}
+
+/// A front triangle (0, 1, 2) under a last layer 1 high, at the foot of a prism of fixed points
+/// 2 high cut into three tetrahedra: the triangle's apex (3) is twice the layer's height, and no
+/// flip or move can help (every point is fixed). A point inserted in the band becomes its apex,
+/// within [1/r, r] of the layer's height, and leaves no sliver.
+#[test]
+fn a_point_inserted_in_the_band_gives_a_front_triangle_its_last_layers_height() {
+    let s = 3f64.sqrt();
+    let base = [DVec3::ZERO, DVec3::X, DVec3::new(0.5, s / 2.0, 0.0)];
+    let mut points = base.to_vec();
+    points.extend(base.map(|p| p + 2.0 * DVec3::Z));
+    let mut mesh = TetMesh::new(points, vec![[0, 1, 2, 3], [1, 2, 3, 4], [2, 3, 4, 5]], 6);
+    let reference = mesh.clone();
+    mesh.keep_front_match(HashMap::from([([0, 1, 2], 1.0)]), 1.2);
+    assert_eq!(mesh.match_front(MatchInsertion::InBand), 1);
+    let on_front =
+        mesh.tets().find(|t| [0, 1, 2].iter().all(|v| t.contains(v))).expect("a tetrahedron on it");
+    assert!(on_front.contains(&6), "the inserted point is its apex: {on_front:?}");
+    let height = mesh.points[6].z;
+    assert!((1.0 / 1.2..=1.2).contains(&height), "height {height}");
+    assert_consistent(&mesh, &reference);
+    assert!(mesh.tets().all(|t| angle_quality(t.map(|v| mesh.points[v as usize])) >= SLIVER_THRESHOLD));
+    assert_eq!(mesh.match_front(MatchInsertion::InBand), 0, "nothing left to match");
 }
