@@ -324,8 +324,8 @@ impl TetMesh {
 
     /// Points in the band over front triangle `key` (its tetrahedron `t`) for a new apex: the
     /// last layer's height over its centre ([`TetMesh::matched_apex`]) first, then heights
-    /// within the band ([`MATCHED_APEX_BAND_POWERS`]) over the centre and over points a quarter,
-    /// half and three quarters of the way to each corner: the centre's cavity often holds a
+    /// within the band ([`MATCHED_APEX_BAND_POWERS`]) over the centre and over points from a
+    /// quarter to nine tenths of the way to each corner: the centre's cavity often holds a
     /// front point nearby, or is not star-shaped. On spot (H = 1e-3 D, 10 layers) the centre
     /// alone left 9.1% of the front triangles out of the band, these 5.1% (growth 1.2).
     fn matched_apex_candidates(&self, t: u32, key: [u32; 3]) -> Vec<DVec3> {
