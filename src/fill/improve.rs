@@ -340,7 +340,8 @@ impl TetMesh {
                     .flat_map(|w| corners.map(|corner| centre + w * (corner - centre))),
             )
             .collect();
-        let band = if self.band.is_finite() { self.band } else { 1.0 };
+        // A last layer's height comes with its band (`keep_front_match`).
+        let band = self.band;
         MATCHED_APEX_BAND_POWERS
             .iter()
             .flat_map(|&k| bases.iter().map(move |&base| base + band.powf(k) * up))
@@ -1282,7 +1283,7 @@ const MATCH_ROUNDS: usize = 6;
 
 /// Heights of the points [`TetMesh::match_front`] inserts over a front triangle: the last
 /// layer's height times the band to these powers, the layer's own height first (r = 1.2: 1,
-/// 0.955, 1.047, 0.913, 1.095, 0.872, 1.147).
+/// 0.955, 1.047, 0.913, 1.095, 0.872, 1.147, 0.849, 1.178).
 const MATCHED_APEX_BAND_POWERS: [f64; 9] = [0.0, -0.25, 0.25, -0.5, 0.5, -0.75, 0.75, -0.9, 0.9];
 
 /// Where over a front triangle [`TetMesh::match_front`] inserts points besides its centre: this
