@@ -683,7 +683,12 @@ impl TetMesh {
 
     /// The other tetrahedron on a face of `t` (none on the boundary).
     fn neighbour(&self, t: u32, face: [u32; 3]) -> Option<u32> {
-        self.tets_with(&face).into_iter().find(|&s| s != t)
+        // As `tets_with`, without collecting: insertions ask this for every face of a cavity.
+        let [first, rest @ ..] = face;
+        self.ball[first as usize]
+            .iter()
+            .copied()
+            .find(|&s| s != t && rest.iter().all(|v| self.tets[s as usize].contains(v)))
     }
 
     /// The tetrahedron holding `p`, walking from `start` across the faces `p` lies beyond;
