@@ -117,10 +117,17 @@ pub fn dihedral_range(kind: CellKind, x: &CellPoints, pairs: &[(usize, usize)]) 
     for (n, f) in normals.iter_mut().zip(faces.iter()) {
         *n = face_normal(f, x);
     }
-    pairs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &(i, j)| {
-        let angle = (-normals[i].dot(normals[j])).clamp(-1.0, 1.0).acos().to_degrees();
-        (lo.min(angle), hi.max(angle))
-    })
+    // The angle falls as its cosine rises: two arc cosines per cell, not one per pair (the
+    // quality measure of every change the core improvement weighs).
+    let (least, most) = pairs.iter().fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &(i, j)| {
+        let cosine = (-normals[i].dot(normals[j])).clamp(-1.0, 1.0);
+        (lo.min(cosine), hi.max(cosine))
+    });
+    let angle = |cosine: f64| cosine.acos().to_degrees();
+    if most == f64::NEG_INFINITY {
+        return (f64::INFINITY, f64::NEG_INFINITY);
+    }
+    (angle(most), angle(least))
 }
 
 #[cfg(test)]
