@@ -623,8 +623,30 @@ impl TetMesh {
     /// best): the tetrahedra whose circumsphere holds `p`, grown from the one holding it (found
     /// by walking from `start`) across interior faces, are replaced by the cone from the new
     /// point over their boundary (Bowyer-Watson). `None` when `p` is outside the region or the
-    /// cone is not positive.
+    /// cone is not positive. When that cone would have a tetrahedron below
+    /// [`SLIVER_THRESHOLD`], the cavity grown across the faces that make them
+    /// ([`TetMesh::grow_cavity_for_quality`]) is tried first, and the Delaunay one only when
+    /// the grown one does no better: the better of the two is taken.
     pub fn insert_point(&self, start: u32, p: DVec3, placement: Placement) -> Option<Change> {
+        let cavity = self.delaunay_cavity(start, p)?;
+        let mut grown = cavity.clone();
+        if !self.grow_cavity_for_quality(&mut grown, p) {
+            return self.fill_cavity(cavity, p, placement);
+        }
+        let grown = self.fill_cavity(grown, p, placement);
+        if grown.as_ref().is_some_and(|c| c.after >= SLIVER_THRESHOLD) {
+            return grown;
+        }
+        match (self.fill_cavity(cavity, p, placement), grown) {
+            (Some(d), Some(g)) => Some(if g.after > d.after { g } else { d }),
+            (d, g) => d.or(g),
+        }
+    }
+
+    /// The tetrahedra whose circumsphere holds `p` (at most [`MAX_CAVITY`]), grown from the
+    /// one holding it (found by walking from `start`) across interior faces, and `start`;
+    /// `None` when `p` is outside the region.
+    fn delaunay_cavity(&self, start: u32, p: DVec3) -> Option<Vec<u32>> {
         let first = self.locate(start, p)?;
         // The tetrahedron to improve goes too, whether or not its circumsphere holds `p`.
         let mut cavity = vec![first];
@@ -636,13 +658,52 @@ impl TetMesh {
             i += 1;
             for face in self.outward_faces(t) {
                 match self.neighbour(t, face) {
-                    Some(n) if !cavity.contains(&n) && cavity.len() < 64 && self.in_circumsphere(n, p) => {
+                    Some(n)
+                        if !cavity.contains(&n)
+                            && cavity.len() < MAX_CAVITY
+                            && self.in_circumsphere(n, p) =>
+                    {
                         cavity.push(n)
                     }
                     _ => {}
                 }
             }
         }
+        Some(cavity)
+    }
+
+    /// Grow `cavity` across its interior faces whose cone from `p` would be below
+    /// [`SLIVER_THRESHOLD`] or not positive, until none is (or it holds [`MAX_CAVITY`]
+    /// tetrahedra): a point near a flat face of the Delaunay cavity, or seeing one from
+    /// behind, makes a sliver there or no cone at all, where the tetrahedron beyond the face
+    /// taken in gives the point a better view. Returns whether it grew.
+    fn grow_cavity_for_quality(&self, cavity: &mut Vec<u32>, p: DVec3) -> bool {
+        let v = self.points.len() as u32;
+        let size = cavity.len();
+        // A face's cone depends on the face and `p` only: each tetrahedron's faces are looked
+        // at once, when it joins.
+        let mut i = 0;
+        while let Some(&t) = cavity.get(i) {
+            i += 1;
+            for face in self.outward_faces(t) {
+                if cavity.len() >= MAX_CAVITY {
+                    break;
+                }
+                let Some(n) = self.neighbour(t, face) else { continue };
+                if !cavity.contains(&n)
+                    && self.quality_at([face[0], face[2], face[1], v], v, p) < SLIVER_THRESHOLD
+                {
+                    cavity.push(n);
+                }
+            }
+        }
+        cavity.len() > size
+    }
+
+    /// The cone from a new point at `p` (or, with [`Placement::Best`], where its tetrahedra
+    /// are best) over the boundary of `cavity`, replacing it; `None` when the cone does not
+    /// fill the cavity exactly (it is not star-shaped from the point, or holds a point).
+    fn fill_cavity(&self, cavity: Vec<u32>, p: DVec3, placement: Placement) -> Option<Change> {
         let v = self.points.len() as u32;
         let mut add = Vec::new();
         for &t in &cavity {
@@ -1282,6 +1343,9 @@ pub enum MatchInsertion {
     /// After the sliver passes, where it cannot leave a tetrahedron below [`SLIVER_THRESHOLD`].
     InBand,
 }
+
+/// The most tetrahedra an insertion's cavity takes ([`TetMesh::insert_point`]).
+const MAX_CAVITY: usize = 64;
 
 /// Rounds of [`TetMesh::match_front`] (a flip can open the way for another).
 const MATCH_ROUNDS: usize = 6;
