@@ -266,9 +266,7 @@ impl TetMesh {
             for &key in &triangles {
                 let &[t] = &self.tets_with(&key)[..] else { continue };
                 let tet = self.tets[t as usize];
-                let stale = unmatched
-                    .get(&key)
-                    .is_some_and(|&at| tet.iter().all(|&v| self.touched[v as usize] <= at));
+                let stale = unmatched.get(&key).is_some_and(|&at| self.untouched_since(tet, at));
                 if stale || self.front_mismatches(tet, None) == 0 {
                     continue;
                 }
@@ -981,17 +979,13 @@ impl TetMesh {
         target: f64,
         stats: &mut ImproveStats,
     ) {
-        // A tetrahedron no operator helped is tried again only once something changed at one
-        // of its nodes: `failed[t]` is the pass it failed in, `changed[v]` the last pass that
-        // changed the tetrahedra at point `v` or moved it.
+        // A tetrahedron no operator helped is tried again only once a change touches one of
+        // its nodes: `failed[t]` is the count of changes applied when it failed.
         let mut failed: Vec<Option<usize>> = vec![None; self.tets.len()];
-        let mut changed = vec![0usize; self.points.len()];
-        for pass in 1..=passes {
-            let stale = |t: usize, tet: &[u32; 4]| {
-                failed[t].is_some_and(|f| tet.iter().all(|&v| changed[v as usize] < f))
-            };
+        for _ in 0..passes {
+            let stale = |t: usize| failed[t].is_some_and(|at| self.untouched_since(self.tets[t], at));
             let mut bad: Vec<(f64, u32)> = (0..self.tets.len())
-                .filter(|&t| self.alive[t] && !stale(t, &self.tets[t]))
+                .filter(|&t| self.alive[t] && !stale(t))
                 .map(|t| (self.quality(self.tets[t]), t as u32))
                 .filter(|&(q, _)| q < target)
                 .collect();
@@ -1006,23 +1000,19 @@ impl TetMesh {
                 }
                 match self.improve_tet(t, options, rule, stats) {
                     Some(change) => {
-                        let touched = change
-                            .remove
-                            .iter()
-                            .map(|&s| self.tets[s as usize])
-                            .chain(change.add.iter().copied());
-                        let nodes: Vec<u32> = touched.flatten().chain(change.point.map(|p| p.0)).collect();
                         self.apply(&change);
-                        changed.resize(self.points.len(), 0);
                         failed.resize(self.tets.len(), None);
-                        for v in nodes {
-                            changed[v as usize] = pass;
-                        }
                     }
-                    None => failed[t as usize] = Some(pass),
+                    None => failed[t as usize] = Some(self.applied),
                 }
             }
         }
+    }
+
+    /// Whether no change applied after the `at`-th touched a node of `tet` (its tetrahedra or
+    /// its place): an operator that found nothing for it then finds nothing now.
+    fn untouched_since(&self, tet: [u32; 4], at: usize) -> bool {
+        tet.iter().all(|&v| self.touched[v as usize] <= at)
     }
 }
 
