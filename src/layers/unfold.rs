@@ -8,7 +8,9 @@
 //! to lie on the line of two stopped ones. Such a top is pulled back along its last step, by
 //! part of that step, to where its front triangles are best; the column keeps its layers (its
 //! last is thinner), every cell at it stays valid (exact test), and the moved front crosses
-//! nothing (exact tests, moves undone until it does not).
+//! nothing (exact tests, moves undone until it does not). A stack at its full count ends on
+//! the exact offset and stays, but at a fold so sharp that every core tetrahedron on its edge
+//! would be a sliver ([`SLIVER_FOLD_ANGLE`]).
 
 use std::collections::HashMap;
 
@@ -29,6 +31,12 @@ const CAP_ANGLE: f64 = 160.0;
 /// tetrahedra at such an edge seldom all keep 10 degrees (20 here left spot 81 tetrahedra below
 /// 10 degrees, 40 leaves 59; at 60 the pulled-back tops cost the flange coverage).
 const FOLD_ANGLE: f64 = 40.0;
+/// A fold sharper than this (degrees) leaves every core tetrahedron at its edge below the core's
+/// sliver bound ([`crate::fill::improve::SLIVER_THRESHOLD`], 10 degrees): there the tops of
+/// full stacks are pulled back too (spot, H = 1e-3 D, 10 layers: its worst core tetrahedron,
+/// 3.7 degrees on a fold of that angle between stacks of 4 and 10 prisms, goes; 20 degrees
+/// here left more slivers on the ONERA M6's wing tip).
+const SLIVER_FOLD_ANGLE: f64 = 10.0;
 /// The parts of its last step a top may be pulled back by.
 const PULL_BACKS: [f64; 4] = [0.2, 0.4, 0.6, 0.8];
 /// Rounds over the defects (a move may make one beside it).
@@ -158,9 +166,13 @@ impl CoreFront {
 
     /// Whether triangle `t` is a cap or on a fold.
     fn is_defect(&self, t: u32) -> bool {
+        self.cap_angle(t) > CAP_ANGLE || self.has_fold_sharper_than(t, FOLD_ANGLE)
+    }
+
+    /// Whether an edge of triangle `t` has an angle on the core's side below `angle` (degrees).
+    fn has_fold_sharper_than(&self, t: u32, angle: f64) -> bool {
         let tri = self.triangles[t as usize];
-        self.cap_angle(t) > CAP_ANGLE
-            || (0..3).any(|i| self.core_angle(sorted_edge(tri[i], tri[(i + 1) % 3])) < FOLD_ANGLE)
+        (0..3).any(|i| self.core_angle(sorted_edge(tri[i], tri[(i + 1) % 3])) < angle)
     }
 
     /// The corners of the quads whose apexes are among `nodes` (a corner's move moves its apex).
@@ -204,8 +216,12 @@ pub fn unfold_front(
             if !core_front.is_defect(t) {
                 continue;
             }
+            let forces_slivers = core_front.has_fold_sharper_than(t, SLIVER_FOLD_ANGLE);
             for v in core_front.triangles[t as usize] {
                 let Some(&c) = tops.get(&v) else { continue };
+                if columns.full_count(c) == Some(columns.layers[c]) && !forces_slivers {
+                    continue;
+                }
                 if let Some(pull) = best_pull_back(&mut core_front, columns, &cells[&v], v, c) {
                     let old = core_front.points[v as usize];
                     moved.entry(v).or_insert((old, columns.last_step[c]));
@@ -246,10 +262,10 @@ fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]
 }
 
 /// The tops that may move, with their column: above the wall, of the one column ending there
-/// that did not merge (the others merged into it), free to move anywhere, and short of its full
-/// stack or beyond it (in its transition layers): a stack that ends at its full count ends on
-/// the exact offset, which a pull-back would leave (a V groove's bisector tops by 15% of the
-/// thickness).
+/// that did not merge (the others merged into it) and free to move anywhere. A stack that ends
+/// at its full count ends on the exact offset, which a pull-back would leave (a V groove's
+/// bisector tops by 15% of the thickness): [`unfold_front`] moves those only at a fold sharper
+/// than [`SLIVER_FOLD_ANGLE`].
 fn movable_tops(columns: &Columns) -> HashMap<u32, usize> {
     let mut ending: HashMap<u32, Vec<usize>> = HashMap::new();
     for c in (0..columns.len()).filter(|&c| columns.merged_into[c] == NOT_MERGED) {
@@ -258,11 +274,7 @@ fn movable_tops(columns: &Columns) -> HashMap<u32, usize> {
     ending
         .into_iter()
         .filter_map(|(v, at)| match at[..] {
-            [c] if columns.layers[c] > 0
-                && columns.full_count(c) != Some(columns.layers[c])
-                && columns.slide[c] == Slide::Free
-                && columns.last_step[c] > 0.0 =>
-            {
+            [c] if columns.layers[c] > 0 && columns.slide[c] == Slide::Free && columns.last_step[c] > 0.0 => {
                 Some((v, c))
             }
             _ => None,
@@ -438,6 +450,22 @@ mod tests {
         assert_eq!(undone, 1);
         assert_eq!(front.points[3], start);
         assert_eq!(columns.last_step[0], 1.0, "its last step is restored");
+    }
+
+    /// A fold of a few degrees forces slivers in the core (full stacks' tops give way there); one
+    /// of 30 degrees is a defect only (they stay).
+    #[test]
+    fn only_a_fold_sharper_than_the_sliver_bound_moves_full_stacks() {
+        let lifted = |degrees: f64| {
+            let a = degrees.to_radians();
+            pair(DVec3::new(0.5, -a.cos(), a.sin()))
+        };
+        let sharp = lifted(5.0);
+        assert!((sharp.core_angle([0, 1]) - 5.0).abs() < 1e-6);
+        assert!(sharp.is_defect(0) && sharp.has_fold_sharper_than(0, SLIVER_FOLD_ANGLE));
+        let mild = lifted(30.0);
+        assert!((mild.core_angle([0, 1]) - 30.0).abs() < 1e-6);
+        assert!(mild.is_defect(0) && !mild.has_fold_sharper_than(0, SLIVER_FOLD_ANGLE));
     }
 
     #[test]
