@@ -482,6 +482,29 @@ fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     assert!(on_prisms >= 0.95, "{:.1}% within [1/r, r] on prisms", 100.0 * on_prisms);
 }
 
+/// Issue 5's size-jump bar on `spot.obj` and the arrow with the defaults: 95% of the first core
+/// tetrahedra within [1/r, r] of the last layer (96.4% and 98.8% measured, since insertions grow
+/// their cavity across faces that would make slivers). The arrow's core has no dihedral angle
+/// below 10 degrees (10.01 measured; 10.01 and 10.00 at growth 1.1999 and 1.2001). Spot's worst
+/// (5.96 measured) is short of the bar where its fronts meet on the symmetry plane; it was 3.7
+/// on a fold of 3.7 degrees between stacks of 4 and 10 prisms, which the unfold now opens by
+/// pulling back the full stack's top too.
+#[test]
+fn spot_and_arrow_default_meshes_have_no_size_jump_at_the_layer_top() {
+    for (name, worst) in [("spot.obj", 5.0), ("arrow_cape.stl", 10.0)] {
+        let out = default_mesh_of_shared(name);
+        let core = out.report.core.as_ref().expect("a core");
+        let jump = &core.size_jump.stats;
+        eprintln!("{name}: size jump {jump:?}, {} slivers", core.quality.slivers.count);
+        assert!(jump.within_band >= 0.95, "{name}: {:.1}% within [1/r, r]", 100.0 * jump.within_band);
+        assert!(
+            core.quality.min_dihedral >= worst,
+            "{name}: core min dihedral {:.2}",
+            core.quality.min_dihedral
+        );
+    }
+}
+
 /// Issue 5 on the ONERA M6 half wing meshed whole (`face9` a wall), with the defaults: the
 /// wing tip's blunt trailing edge and cap are faceted at 0.2-0.4 under a first layer of 1.675
 /// (H = 1e-3 D), and 49 of its wall vertices got no layer. Those stacks' first height is now
