@@ -207,7 +207,7 @@ pub fn unfold_front(
     if stats.defects_before == 0 {
         return stats;
     }
-    let tops = movable_tops(columns);
+    let tops = movable_tops(columns, &core_front);
     let cells = cells_at(mesh, &tops);
     let mut moved: HashMap<u32, (DVec3, f64)> = HashMap::new();
     for _ in 0..ROUNDS {
@@ -264,9 +264,16 @@ fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]
 /// The tops that may move, with their column: above the wall, of the one column ending there
 /// that did not merge (the others merged into it) and free to move anywhere. A stack that ends
 /// at its full count ends on the exact offset, which a pull-back would leave (a V groove's
-/// bisector tops by 15% of the thickness): [`unfold_front`] moves those only at a fold sharper
-/// than [`SLIVER_FOLD_ANGLE`].
-fn movable_tops(columns: &Columns) -> HashMap<u32, usize> {
+/// bisector tops by 15% of the thickness): such a top may move only where it is on a fold of
+/// `front` sharper than [`SLIVER_FOLD_ANGLE`] (and [`unfold_front`] moves it only for such a
+/// fold).
+fn movable_tops(columns: &Columns, front: &CoreFront) -> HashMap<u32, usize> {
+    let mut on_sharp_fold = std::collections::HashSet::new();
+    for t in 0..front.triangles.len() as u32 {
+        if front.has_fold_sharper_than(t, SLIVER_FOLD_ANGLE) {
+            on_sharp_fold.extend(front.triangles[t as usize]);
+        }
+    }
     let mut ending: HashMap<u32, Vec<usize>> = HashMap::new();
     for c in (0..columns.len()).filter(|&c| columns.merged_into[c] == NOT_MERGED) {
         ending.entry(columns.node[c]).or_default().push(c);
@@ -274,7 +281,11 @@ fn movable_tops(columns: &Columns) -> HashMap<u32, usize> {
     ending
         .into_iter()
         .filter_map(|(v, at)| match at[..] {
-            [c] if columns.layers[c] > 0 && columns.slide[c] == Slide::Free && columns.last_step[c] > 0.0 => {
+            [c] if columns.layers[c] > 0
+                && (columns.full_count(c) != Some(columns.layers[c]) || on_sharp_fold.contains(&v))
+                && columns.slide[c] == Slide::Free
+                && columns.last_step[c] > 0.0 =>
+            {
                 Some((v, c))
             }
             _ => None,
