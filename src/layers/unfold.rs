@@ -219,7 +219,7 @@ pub fn unfold_front(
             let forces_slivers = core_front.has_fold_sharper_than(t, SLIVER_FOLD_ANGLE);
             for v in core_front.triangles[t as usize] {
                 let Some(&c) = tops.get(&v) else { continue };
-                if columns.full_count(c) == Some(columns.layers[c]) && !forces_slivers {
+                if ends_at_full_count(columns, c) && !forces_slivers {
                     continue;
                 }
                 if let Some(pull) = best_pull_back(&mut core_front, columns, &cells[&v], v, c) {
@@ -282,7 +282,7 @@ fn movable_tops(columns: &Columns, front: &CoreFront) -> HashMap<u32, usize> {
         .into_iter()
         .filter_map(|(v, at)| match at[..] {
             [c] if columns.layers[c] > 0
-                && (columns.full_count(c) != Some(columns.layers[c]) || on_sharp_fold.contains(&v))
+                && (!ends_at_full_count(columns, c) || on_sharp_fold.contains(&v))
                 && columns.slide[c] == Slide::Free
                 && columns.last_step[c] > 0.0 =>
             {
@@ -291,6 +291,12 @@ fn movable_tops(columns: &Columns, front: &CoreFront) -> HashMap<u32, usize> {
             _ => None,
         })
         .collect()
+}
+
+/// Whether column `c`'s stack ends at its full count (on the exact offset): neither short of it
+/// nor in its transition layers.
+fn ends_at_full_count(columns: &Columns, c: usize) -> bool {
+    columns.full_count(c) == Some(columns.layers[c])
 }
 
 /// The layer cells at each of `tops`, as (kind, nodes).
@@ -463,10 +469,10 @@ mod tests {
         assert_eq!(columns.last_step[0], 1.0, "its last step is restored");
     }
 
-    /// A fold of a few degrees forces slivers in the core (full stacks' tops give way there); one
-    /// of 30 degrees is a defect only (they stay).
+    /// A fold of a few degrees forces slivers in the core (where full stacks' tops give way);
+    /// one of 30 degrees is a defect only (where they stay).
     #[test]
-    fn only_a_fold_sharper_than_the_sliver_bound_moves_full_stacks() {
+    fn a_fold_sharper_than_the_sliver_bound_is_told_from_a_mild_one() {
         let lifted = |degrees: f64| {
             let a = degrees.to_radians();
             pair(DVec3::new(0.5, -a.cos(), a.sin()))
