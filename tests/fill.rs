@@ -516,9 +516,13 @@ fn onera_m6_tip_gets_its_layers_with_a_first_height_fitted_to_the_wall() {
     let out = default_mesh_of_shared("onera_m6_gmsh_coarse.stl");
     let layers = &out.report.layers;
     assert!(layers.lowered_first_height_vertices > 0);
-    assert!(layers.stopped_vertices <= 30, "{} stopped", layers.stopped_vertices);
+    // Around the one stack left with no layer (the tip's trailing-edge corner) the stacks stop
+    // on a cone (`grade_around_pits`): 37 stopped wall vertices measured, no core tetrahedron
+    // below 10 deg (12 before the cone, the worst 0.95 deg).
+    assert!(layers.stopped_vertices <= 50, "{} stopped", layers.stopped_vertices);
     let core = out.report.core.as_ref().expect("a core");
-    assert!(core.quality.slivers.count <= 30, "{} tetrahedra below 10 deg", core.quality.slivers.count);
+    assert!(core.quality.slivers.count <= 2, "{} tetrahedra below 10 deg", core.quality.slivers.count);
+    assert!(core.quality.min_dihedral > 5.0, "worst dihedral {:.2} deg", core.quality.min_dihedral);
     let jump = &core.size_jump.stats;
     assert!(jump.within_band >= 0.95, "{:.1}% within [1/r, r]", 100.0 * jump.within_band);
 }
