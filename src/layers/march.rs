@@ -60,6 +60,8 @@ pub struct MarchStats {
     pub splits_given_up: usize,
     /// Front edges swapped (a pair of badly shaped triangles turned over their shared edge).
     pub swaps: usize,
+    /// Columns stopped on the cone around a stack with no layer ([`grade_around_pits`]).
+    pub columns_stopped_for_pits: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -419,7 +421,7 @@ pub fn march(
                 columns.alive[c] = false;
             }
         }
-        grade_around_pits(columns, front, &mut pit, k);
+        stats.columns_stopped_for_pits += grade_around_pits(columns, front, &mut pit, k);
         if (0..columns.len()).any(|c| columns.stops_when_isotropic(c, k)) {
             let wall_size = matches!(sizes.adapt, Adapt::Off).then_some(sizes.wall.as_slice());
             stop_isotropic_columns(mesh, columns, front, k, wall_size);
@@ -880,8 +882,9 @@ const PIT_SLOPE: f64 = 3.0;
 /// (its walls are steep and narrow: the ONERA M6's wing tip). Around such a stack, and around
 /// the ones stopped for it, a stack stops before it rises above its neighbour's thickness by
 /// more than [`PIT_SLOPE`] times the distance between their wall points, so the pit opens into
-/// a cone. `pit` records the thickness of each stack stopped in a pit.
-fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<f64>>, k: u32) {
+/// a cone. `pit` records the thickness of each stack stopped in a pit. Returns how many columns
+/// stopped.
+fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<f64>>, k: u32) -> usize {
     // Splits add columns as the front marches.
     pit.resize(columns.len(), None);
     for (c, depth) in pit.iter_mut().enumerate() {
@@ -903,13 +906,14 @@ fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<
             .filter_map(|n| Some((n, pit[n as usize]?)))
             .any(|(n, h)| height > h + PIT_SLOPE * columns.base[c].distance(columns.base[n as usize]));
         if too_high {
-            stop.push(c);
+            stop.push(c as u32);
         }
     }
-    for c in stop {
-        columns.alive[c] = false;
-        pit[c] = Some(columns.distance(c, k - 1).unwrap_or(0.0));
+    for &c in &stop {
+        columns.alive[c as usize] = false;
+        pit[c as usize] = Some(columns.distance(c as usize, k - 1).unwrap_or(0.0));
     }
+    stop.len()
 }
 
 /// Stop the columns of face `f`; when `f` is a fan face (a strip quad, a ridge end's
