@@ -888,11 +888,12 @@ fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<
     // Splits add columns as the front marches.
     pit.resize(columns.len(), None);
     for (c, depth) in pit.iter_mut().enumerate() {
-        // Stopped with no layer: not merged on, not ending at its count, not held by the wall.
+        // Stopped with no layer: not merged on, not held by the wall, not ended at isotropy.
         let stopped = !columns.alive[c]
             && columns.merged_into[c] == NOT_MERGED
             && columns.spec[c].is_some()
-            && columns.slide[c] != Slide::Fixed;
+            && columns.slide[c] != Slide::Fixed
+            && columns.isotropic_ratio[c].is_nan();
         if depth.is_none() && stopped && columns.layers[c] == 0 {
             *depth = Some(0.0);
         }
@@ -1196,8 +1197,8 @@ mod tests {
     /// Stacks over a strip of wall, two columns wide and eight long (column `2 i + j` at
     /// `(i STRIP_STEP, j)`), marched 10 layers (first height 0.1, growth 1.2: 2.6 thick) with
     /// [`grade_around_pits`] before each, the two columns at `i = 0` stopped first with
-    /// `first_stop` layers: their layer counts along the strip.
-    fn strip_marched_around(first_stop: u32) -> Vec<u32> {
+    /// `first_stop` layers (at isotropy if `isotropic`): their layer counts along the strip.
+    fn strip_marched_around(first_stop: u32, isotropic: bool) -> Vec<u32> {
         let bottoms: Vec<DVec3> =
             (0..16).map(|c| DVec3::new((c / 2) as f64 * STRIP_STEP, (c % 2) as f64, 0.0)).collect();
         let mut columns = Columns::rising(&bottoms, Some(LayerSpec::fixed(0.1, 1.2, 10)));
@@ -1212,8 +1213,12 @@ mod tests {
         let mut pit = Vec::new();
         for k in 1..=10 {
             if k == first_stop + 1 {
-                columns.alive[0] = false;
-                columns.alive[1] = false;
+                for c in [0, 1] {
+                    columns.alive[c] = false;
+                    if isotropic {
+                        columns.isotropic_ratio[c] = 1.0;
+                    }
+                }
             }
             grade_around_pits(&mut columns, &front, &mut pit, k);
             for c in 0..16 {
@@ -1226,7 +1231,7 @@ mod tests {
     #[test]
     fn stacks_around_a_stack_with_no_layer_open_it_into_a_cone() {
         let spec = LayerSpec::fixed(0.1, 1.2, 10);
-        let layers = strip_marched_around(0);
+        let layers = strip_marched_around(0, false);
         for i in 1..layers.len() {
             // The thickest stack within the slope over its neighbour towards the pit, or full.
             let thickness = |n: u32| spec.distance(n);
@@ -1235,8 +1240,11 @@ mod tests {
             assert!(rising && (l == 10 || thickness(l + 1) > below), "{layers:?}");
         }
         assert!(layers[1] < 10 && layers[7] == 10, "a cone, closed within the strip: {layers:?}");
-        // A stack that stopped with layers leaves no pit to the wall: its neighbours go on.
-        assert_eq!(strip_marched_around(4), [4, 10, 10, 10, 10, 10, 10, 10]);
+        // A stack that stopped with layers leaves no pit to the wall, nor one that ended at
+        // isotropy (`count = "auto"` over a wall faceted finer than the first layer): its
+        // neighbours go on.
+        assert_eq!(strip_marched_around(4, false), [4, 10, 10, 10, 10, 10, 10, 10]);
+        assert_eq!(strip_marched_around(0, true), [0, 10, 10, 10, 10, 10, 10, 10]);
     }
 
     #[test]
