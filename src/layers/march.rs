@@ -898,18 +898,19 @@ fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<
             *depth = Some(0.0);
         }
     }
+    // From the pits out to the live stacks sharing a front face with them (none on most walls).
     let mut stop = Vec::new();
-    for c in (0..columns.len()).filter(|&c| columns.alive[c]) {
-        let Some(height) = columns.distance(c, k) else { continue };
-        let too_high = front
-            .faces_of(c as u32)
-            .flat_map(|f| front.face_columns(f).iter().copied())
-            .filter_map(|n| Some((n, pit[n as usize]?)))
-            .any(|(n, h)| height > h + PIT_SLOPE * columns.base[c].distance(columns.base[n as usize]));
-        if too_high {
-            stop.push(c as u32);
+    for (n, h) in pit.iter().enumerate().filter_map(|(n, h)| Some((n, (*h)?))) {
+        for c in front.faces_of(n as u32).flat_map(|f| front.face_columns(f)) {
+            let c = *c as usize;
+            let Some(height) = columns.distance(c, k).filter(|_| columns.alive[c]) else { continue };
+            if height > h + PIT_SLOPE * columns.base[c].distance(columns.base[n]) {
+                stop.push(c as u32);
+            }
         }
     }
+    stop.sort_unstable();
+    stop.dedup();
     for &c in &stop {
         columns.alive[c as usize] = false;
         pit[c as usize] = Some(columns.distance(c as usize, k - 1).unwrap_or(0.0));
