@@ -65,7 +65,9 @@ fn main() {
         let picked =
             if wanted.is_empty() { full || name != "refined" } else { wanted.iter().any(|w| w == name) };
         if picked {
-            bench(name, runs, || build_layers(&surface, &topology, &normals, &patch_spec, adapt, |_, _| {}));
+            bench(name, runs, || {
+                build_layers(&surface, &topology, &normals, &patch_spec, adapt, &[], |_, _| {})
+            });
         }
     }
 }

@@ -112,6 +112,10 @@ struct MeshArgs {
     /// Write only the layers (no core tetrahedra).
     #[arg(long)]
     no_core: bool,
+    /// March again at most N times with the stacks under the core's slivers a layer lower
+    /// (default 8; 0: never).
+    #[arg(long, value_name = "N")]
+    peel_rounds: Option<usize>,
     /// Do not split or collapse the layers' front edges to the tangential sizes (tangential adaptivity).
     #[arg(long)]
     no_adapt: bool,
@@ -302,6 +306,7 @@ fn mesh_config(args: &MeshArgs) -> Result<Config> {
     }
     config.feature_angle = args.feature_angle.or(config.feature_angle);
     config.fan_angle = args.fan_angle.or(config.fan_angle);
+    config.peel_rounds = args.peel_rounds.or(config.peel_rounds);
     if args.no_adapt {
         config.sizing.adapt = Some(false);
     }

@@ -4,6 +4,7 @@
 use serde::Serialize;
 
 use crate::config::{Config, ConfigError, Flow, LayerSpec, Role};
+use crate::fill::improve::{min_dihedral, SLIVER_THRESHOLD};
 use crate::fill::{fill_core_on_symmetry_plane, CoreOptions, CoreStats, FillError};
 use crate::layers::sliding::SlidingError;
 use crate::layers::{self, Adapt, MarchStats};
@@ -57,6 +58,8 @@ pub struct MeshReport {
     pub features: FeatureCounts,
     pub normals: NormalStats,
     pub layers: LayerSummary,
+    /// The rounds that marched again with the stacks under the core's slivers lower.
+    pub peel: PeelStats,
     /// The core fill, when it was run.
     pub core: Option<CoreStats>,
     pub cells: CellCounts,
@@ -193,52 +196,20 @@ pub fn run(
         (Some(field), true) => Adapt::Field(field),
         (None, true) => Adapt::Wall,
     };
-    let bar = progress.bar(0, "layers");
-    let (mut layered, core_wall) = timings.time("layers", || {
-        let mut layered =
-            layers::build_layers(&surface, &topology, &wall_normals, &patch_spec, adapt, |k, n| {
-                bar.set_length(n as u64);
-                bar.set_position(k as u64);
-            });
-        let core_wall =
-            layers::sliding::close_sliding_patches(&mut layered.mesh, &surface, &planes, &symmetry_patch);
-        (layered, core_wall)
-    });
-    bar.finish_and_clear();
-    let closed = core_wall?;
-    let symmetry = match closed.symmetry.as_slice() {
-        [] => None,
-        [one] => Some(one),
-        [_, more @ ..] => {
-            let names: Vec<&str> =
-                more.iter().map(|s| surface.patch_names[s.patch as usize].as_str()).collect();
-            return Err(MeshError::Unsupported(format!(
-                "more than one symmetry plane with the body on it (also {names:?}): the farfield can \
-                 be cut by one only"
-            )));
-        }
+    let stages = LayersAndCore {
+        surface: &surface,
+        topology: &topology,
+        wall_normals: &wall_normals,
+        patch_spec: &patch_spec,
+        adapt,
+        planes: &planes,
+        symmetry_patch: &symmetry_patch,
+        config,
+        options,
+        progress: &progress,
     };
+    let (Round { layered, mesh, core, .. }, peel) = stages.run_peeling(&mut timings)?;
     let layer_summary = layer_summary(&layered, &surface, &topology, &features);
-    let (mesh, core) = if options.core {
-        let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
-        let (mesh, mut stats) = timings.time("core", || {
-            let mut options = CoreOptions::from_config(config);
-            options.improve.size_band = growth;
-            fill_core_on_symmetry_plane(&layered.mesh, &closed.core_wall, &options, symmetry)
-        })?;
-        let core_zone = mesh.zone_names.iter().position(|z| z == crate::fill::CORE_ZONE_NAME);
-        if let Some(core_zone) = core_zone {
-            stats.size_jump = crate::fill::size_jump::measure(
-                &mesh,
-                crate::layers::march::LAYER_ZONE,
-                core_zone as u32,
-                growth,
-            );
-        }
-        (mesh, Some(stats))
-    } else {
-        (std::mem::take(&mut layered.mesh), None)
-    };
     let check = timings.time("check", || quality::check(&mesh));
     if !check.is_valid() {
         return Err(MeshError::InvalidResult(Box::new(check)));
@@ -253,6 +224,7 @@ pub fn run(
         features: features.counts.clone(),
         normals: wall_normals.stats.clone(),
         layers: layer_summary,
+        peel,
         core,
         cells: CellCounts::of(&mesh),
         check,
@@ -262,6 +234,194 @@ pub fn run(
         warnings,
     };
     Ok(MeshOutput { mesh, report })
+}
+
+/// The layers and the core of one march: what [`LayersAndCore::round`] needs.
+struct LayersAndCore<'a> {
+    surface: &'a Surface,
+    topology: &'a Topology,
+    wall_normals: &'a normals::WallNormals,
+    patch_spec: &'a [Option<LayerSpec>],
+    adapt: Adapt<'a>,
+    planes: &'a [Option<Plane>],
+    symmetry_patch: &'a [bool],
+    config: &'a Config,
+    options: &'a MeshOptions,
+    progress: &'a Progress,
+}
+
+/// A march and its core.
+struct Round {
+    layered: layers::Layers,
+    mesh: VolumeMesh,
+    core: Option<CoreStats>,
+    slivers: SliverScore,
+}
+
+/// What the peeling rounds did ([`LayersAndCore::run_peeling`]).
+#[derive(Clone, Debug, Default, Serialize)]
+pub struct PeelStats {
+    /// Core tetrahedra below 10 deg after each round (the first is the plain march's).
+    pub slivers_by_round: Vec<usize>,
+    /// The round whose mesh was kept: the fewest slivers, then the best worst angle.
+    pub kept_round: usize,
+    /// Wall vertices whose stack was capped a layer under its top in the kept round's march.
+    pub capped_vertices: usize,
+}
+
+impl LayersAndCore<'_> {
+    /// March, fill the core, and while it leaves a few slivers (at most
+    /// [`PEEL_MAX_SLIVER_SHARE`] of the front's nodes), march again with the stacks under their
+    /// front nodes a layer lower: the core there had no room for a good tetrahedron (fronts
+    /// meeting head on in a crevice, a crumpled front), and one layer less gives it room. At
+    /// most `peel_rounds` more marches; the round with the fewest slivers (then the best worst
+    /// angle) is kept.
+    fn run_peeling(&self, timings: &mut Timings) -> Result<(Round, PeelStats), MeshError> {
+        let mut caps = vec![u32::MAX; self.surface.points.len()];
+        let mut stats = PeelStats::default();
+        let mut best: Option<Round> = None;
+        let mut kept_caps = 0;
+        for round in 0..=self.config.peel_rounds() {
+            let this = self.round(&caps, timings)?;
+            stats.slivers_by_round.push(this.slivers.tets.len());
+            let front_nodes = this.layered.top_stacks.len() as f64;
+            let peelable = this.slivers.tets.len() as f64 <= PEEL_MAX_SLIVER_SHARE * front_nodes;
+            let capped_now = caps.iter().filter(|&&c| c != u32::MAX).count();
+            let lowered = if peelable { this.slivers.lower_caps(&this.layered, &mut caps) } else { 0 };
+            tracing::info!(
+                round,
+                slivers = this.slivers.tets.len(),
+                worst = this.slivers.worst,
+                lowered,
+                "core slivers"
+            );
+            if best.as_ref().is_none_or(|b| this.slivers.better_than(&b.slivers)) {
+                stats.kept_round = round;
+                kept_caps = capped_now;
+                best = Some(this);
+            }
+            if lowered == 0 {
+                break;
+            }
+        }
+        stats.capped_vertices = kept_caps;
+        Ok((best.expect("one round at least"), stats))
+    }
+
+    /// March with the stacks at most `caps` layers high (by wall vertex) and fill the core.
+    fn round(&self, caps: &[u32], timings: &mut Timings) -> Result<Round, MeshError> {
+        let surface = self.surface;
+        let bar = self.progress.bar(0, "layers");
+        let (mut layered, core_wall) = timings.time("layers", || {
+            let mut layered = layers::build_layers(
+                surface,
+                self.topology,
+                self.wall_normals,
+                self.patch_spec,
+                self.adapt,
+                caps,
+                |k, n| {
+                    bar.set_length(n as u64);
+                    bar.set_position(k as u64);
+                },
+            );
+            let core_wall = layers::sliding::close_sliding_patches(
+                &mut layered.mesh,
+                surface,
+                self.planes,
+                self.symmetry_patch,
+            );
+            (layered, core_wall)
+        });
+        bar.finish_and_clear();
+        let closed = core_wall?;
+        let symmetry = match closed.symmetry.as_slice() {
+            [] => None,
+            [one] => Some(one),
+            [_, more @ ..] => {
+                let names: Vec<&str> =
+                    more.iter().map(|s| surface.patch_names[s.patch as usize].as_str()).collect();
+                return Err(MeshError::Unsupported(format!(
+                    "more than one symmetry plane with the body on it (also {names:?}): the farfield \
+                     can be cut by one only"
+                )));
+            }
+        };
+        if !self.options.core {
+            let mesh = std::mem::take(&mut layered.mesh);
+            return Ok(Round { layered, mesh, core: None, slivers: SliverScore::default() });
+        }
+        let growth = self.patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
+        let (mesh, mut stats) = timings.time("core", || {
+            let mut options = CoreOptions::from_config(self.config);
+            options.improve.size_band = growth;
+            fill_core_on_symmetry_plane(&layered.mesh, &closed.core_wall, &options, symmetry)
+        })?;
+        let mut slivers = SliverScore::default();
+        if let Some(core_zone) = mesh.zone_names.iter().position(|z| z == crate::fill::CORE_ZONE_NAME) {
+            let (layer_zone, core_zone) = (crate::layers::march::LAYER_ZONE, core_zone as u32);
+            stats.size_jump = crate::fill::size_jump::measure(&mesh, layer_zone, core_zone, growth);
+            slivers = SliverScore::of(&mesh, core_zone);
+        }
+        Ok(Round { layered, mesh, core: Some(stats), slivers })
+    }
+}
+
+/// The most slivers, as a share of the front's nodes, that peeling tries to mend: more come
+/// from elsewhere (a wall faceted too coarsely for its layers: the elbow, wtc2), and peeling
+/// would strip their layers.
+const PEEL_MAX_SLIVER_SHARE: f64 = 0.01;
+
+/// The core tetrahedra below [`SLIVER_THRESHOLD`] and the worst angle.
+#[derive(Clone, Debug)]
+struct SliverScore {
+    tets: Vec<[u32; 4]>,
+    worst: f64,
+}
+
+impl Default for SliverScore {
+    fn default() -> Self {
+        SliverScore { tets: Vec::new(), worst: 180.0 }
+    }
+}
+
+impl SliverScore {
+    fn of(mesh: &VolumeMesh, core_zone: u32) -> SliverScore {
+        let block = mesh.block(CellKind::Tetrahedron);
+        let mut score = SliverScore::default();
+        for (i, &zone) in block.zone.iter().enumerate() {
+            let Ok(tet) = <[u32; 4]>::try_from(block.cell(i)) else { continue };
+            if zone != core_zone {
+                continue;
+            }
+            let angle = min_dihedral(tet.map(|v| mesh.points[v as usize]));
+            score.worst = score.worst.min(angle);
+            if angle < SLIVER_THRESHOLD {
+                score.tets.push(tet);
+            }
+        }
+        score
+    }
+
+    fn better_than(&self, other: &SliverScore) -> bool {
+        self.tets.len() < other.tets.len()
+            || (self.tets.len() == other.tets.len() && self.worst > other.worst)
+    }
+
+    /// Cap the stacks under the slivers' front nodes a layer under their top (a stack keeps
+    /// one layer at least: none would leave a pit). Returns how many caps were lowered.
+    fn lower_caps(&self, layered: &layers::Layers, caps: &mut [u32]) -> usize {
+        let mut lowered = 0;
+        for node in self.tets.iter().flatten() {
+            let Some(&(v, reached)) = layered.top_stacks.get(node) else { continue };
+            let cap = &mut caps[v as usize];
+            if reached >= 2 && reached - 1 < *cap {
+                *cap = reached - 1;
+                lowered += 1;
+            }
+        }
+        lowered
+    }
 }
 
 /// Cuts for the pictures: across the most concave ridge edge (normal along it, through its
@@ -512,8 +672,8 @@ impl std::fmt::Display for MeshReport {
                 }
                 writeln!(
                     f,
-                    "          improvement: {} flips and moves to match the first core cells to the last layer, then {} flips 2-3, {} 3-2, {} 4-4, {} larger edge removals, {} points smoothed, {} inserted ({:.2} s)",
-                    i.front_matches, i.flips_23, i.flips_32, i.flips_44, i.edge_removals, i.smoothed_points, i.inserted_points, i.seconds
+                    "          improvement: {} flips and moves to match the first core cells to the last layer, then {} flips 2-3, {} 3-2, {} 4-4, {} larger edge removals, {} points smoothed, {} removed, {} inserted ({:.2} s)",
+                    i.front_matches, i.flips_23, i.flips_32, i.flips_44, i.edge_removals, i.smoothed_points, i.collapsed_edges, i.inserted_points, i.seconds
                 )?;
                 writeln!(
                     f,
@@ -521,6 +681,18 @@ impl std::fmt::Display for MeshReport {
                     s.count, s.threshold, s.boundary_angle, s.boundary_triangle, s.thin_gap, s.not_forced, s.all_nodes_on_boundary
                 )?;
                 writeln!(f, "          min dihedral per tetrahedron (deg): {}", q.histogram)?;
+                let p = &self.peel;
+                if p.slivers_by_round.len() > 1 {
+                    let counts: Vec<String> = p.slivers_by_round.iter().map(usize::to_string).collect();
+                    writeln!(
+                        f,
+                        "          peeling: tetrahedra below {:.0} deg by round {}; kept round {}, its stacks a layer lower at {} wall vertices",
+                        s.threshold,
+                        counts.join(" -> "),
+                        p.kept_round,
+                        p.capped_vertices
+                    )?;
+                }
                 let j = &c.size_jump;
                 let bins: Vec<String> =
                     j.histogram.iter().map(|(label, n)| format!("{label}: {n}")).collect();

@@ -109,6 +109,8 @@ pub struct ImproveStats {
     /// Edge removals with rings of 5 to [`MAX_RING`] tetrahedra.
     pub edge_removals: usize,
     pub smoothed_points: usize,
+    /// Added points removed by merging them into a neighbour ([`TetMesh::collapse_edge`]).
+    pub collapsed_edges: usize,
     pub inserted_points: usize,
     /// Flips and moves that gave a first core tetrahedron the last layer's height
     /// ([`TetMesh::match_front`]).
@@ -400,9 +402,19 @@ impl TetMesh {
         self.tets.iter().zip(&self.alive).filter(|(_, &a)| a).map(|(t, _)| *t)
     }
 
+    /// The points and live tetrahedra; points an edge collapse removed are dropped (the
+    /// fixed points keep their indices).
     pub fn into_parts(self) -> (Vec<DVec3>, Vec<[u32; 4]>) {
-        let tets = self.tets().collect();
-        (self.points, tets)
+        let mut index = vec![u32::MAX; self.points.len()];
+        let mut points = Vec::with_capacity(self.points.len());
+        for (v, p) in self.points.iter().enumerate() {
+            if v < self.fixed || !self.ball[v].is_empty() {
+                index[v] = points.len() as u32;
+                points.push(*p);
+            }
+        }
+        let tets = self.tets().map(|t| t.map(|v| index[v as usize])).collect();
+        (points, tets)
     }
 
     fn corners(&self, tet: [u32; 4]) -> [DVec3; 4] {
@@ -577,6 +589,39 @@ impl TetMesh {
             stack.push((k, j));
         }
         Some(add)
+    }
+
+    /// Edge collapse: remove the added point `a` by merging it into `b`, a node of its star:
+    /// the tetrahedra at `a` without `b` take `b` in its place, those with both go. `None`
+    /// when `a` is fixed or a new tetrahedron is not positive (then the cone from `b` does not
+    /// fill the star of `a`).
+    pub fn collapse_edge(&self, a: u32, b: u32) -> Option<Change> {
+        if (a as usize) < self.fixed {
+            return None;
+        }
+        let remove = self.ball[a as usize].clone();
+        let add: Vec<[u32; 4]> = remove
+            .iter()
+            .map(|&t| self.tets[t as usize])
+            .filter(|t| !t.contains(&b))
+            .map(|t| t.map(|v| if v == a { b } else { v }))
+            .collect();
+        if add.len() == remove.len() {
+            return None;
+        }
+        let volume = |tets: &mut dyn Iterator<Item = [u32; 4]>| {
+            tets.map(|t| {
+                let [p, q, r, s] = self.corners(t);
+                crate::geometry::tet_signed_volume(p, q, r, s)
+            })
+            .sum::<f64>()
+        };
+        let old = volume(&mut remove.iter().map(|&t| self.tets[t as usize]));
+        let new = volume(&mut add.iter().copied());
+        if (new - old).abs() > 1e-9 * old {
+            return None;
+        }
+        self.change(remove, add, None)
     }
 
     /// Move the added point `v` where the worst tetrahedron at it is best.
@@ -912,6 +957,15 @@ impl TetMesh {
         let smoothing = tet.iter().filter_map(|&v| self.smooth_vertex(v)).collect();
         if let Some(change) = self.best_improving(smoothing, rule) {
             stats.smoothed_points += 1;
+            return Some(change);
+        }
+        let collapses = TET_EDGES
+            .iter()
+            .flat_map(|&(i, j)| [(tet[i], tet[j]), (tet[j], tet[i])])
+            .filter_map(|(a, b)| self.collapse_edge(a, b))
+            .collect();
+        if let Some(change) = self.best_improving(collapses, rule) {
+            stats.collapsed_edges += 1;
             return Some(change);
         }
         // The front moves only to mend a sliver.

@@ -62,6 +62,9 @@ pub struct MarchStats {
     pub swaps: usize,
     /// Columns stopped on the cone around a stack with no layer ([`grade_around_pits`]).
     pub columns_stopped_for_pits: usize,
+    /// Columns stopped a layer under where the core could not fill around their tops
+    /// ([`stop_at_caps`]).
+    pub columns_stopped_at_caps: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -401,7 +404,9 @@ fn cell_of_face(
 /// stack before the first layer whose height would reach the front's edge length around them
 /// (`count = "auto"`); they are marked in `columns.isotropic_ratio`. Unless `sizes.adapt` is
 /// off, front edges
-/// that grow too long for `sizes` are split ([`super::split`]), which adds columns.
+/// that grow too long for `sizes` are split ([`super::split`]), which adds columns. `caps` holds
+/// the most layers of every wall vertex's stack ([`stop_at_caps`]).
+#[allow(clippy::too_many_arguments)]
 pub fn march(
     mesh: &mut VolumeMesh,
     columns: &mut Columns,
@@ -409,6 +414,7 @@ pub fn march(
     max_layers: u32,
     sizes: &mut Sizes,
     walls: &VertexWalls,
+    caps: &[u32],
     mut on_layer: impl FnMut(u32),
 ) -> MarchStats {
     let mut stats = MarchStats::default();
@@ -421,6 +427,7 @@ pub fn march(
                 columns.alive[c] = false;
             }
         }
+        stats.columns_stopped_at_caps += stop_at_caps(columns, caps, &mut pit, k);
         stats.columns_stopped_for_pits += grade_around_pits(columns, front, &mut pit, k);
         if (0..columns.len()).any(|c| columns.stops_when_isotropic(c, k)) {
             let wall_size = matches!(sizes.adapt, Adapt::Off).then_some(sizes.wall.as_slice());
@@ -878,6 +885,23 @@ fn repair_invalid_cells(
 /// 3/0/0 and 99.63%; at 3, 0/0/1 (worst 9.6 deg) and 99.74%; at 4, 5/6/7 (worst 3.2 deg).
 const PIT_SLOPE: f64 = 3.0;
 
+/// Stop the live columns whose wall vertex's stack is capped below layer `k` (`caps`, by wall
+/// vertex: the core could not fill around their tops, [`crate::pipeline`]); they count as
+/// pits of their thickness for [`grade_around_pits`]. Returns how many stopped.
+fn stop_at_caps(columns: &mut Columns, caps: &[u32], pit: &mut Vec<Option<f64>>, k: u32) -> usize {
+    pit.resize(columns.len(), None);
+    let mut stopped = 0;
+    for (c, depth) in pit.iter_mut().enumerate() {
+        let capped = caps.get(columns.wall_vertex[c] as usize).is_some_and(|&cap| cap < k);
+        if columns.alive[c] && capped {
+            columns.alive[c] = false;
+            *depth = Some(columns.distance(c, k - 1).unwrap_or(0.0));
+            stopped += 1;
+        }
+    }
+    stopped
+}
+
 /// Stacks that stopped with no layer leave a pit to the wall that the core fills with slivers
 /// (its walls are steep and narrow: the ONERA M6's wing tip). Around such a stack, and around
 /// the ones stopped for it, a stack stops before it rises above its neighbour's thickness by
@@ -1197,9 +1221,10 @@ mod tests {
 
     /// Stacks over a strip of wall, two columns wide and eight long (column `2 i + j` at
     /// `(i STRIP_STEP, j)`), marched 10 layers (first height 0.1, growth 1.2: 2.6 thick) with
-    /// [`grade_around_pits`] before each, the two columns at `i = 0` stopped first with
-    /// `first_stop` layers (at isotropy if `isotropic`): their layer counts along the strip.
-    fn strip_marched_around(first_stop: u32, isotropic: bool) -> Vec<u32> {
+    /// [`stop_at_caps`] (`caps` by column) and [`grade_around_pits`] before each, the two
+    /// columns at `i = 0` stopped first with `first_stop` layers (at isotropy if `isotropic`):
+    /// the layer counts of the columns at `j = 0` along the strip.
+    fn strip_marched_around(first_stop: u32, isotropic: bool, caps: &[u32]) -> Vec<u32> {
         let bottoms: Vec<DVec3> =
             (0..16).map(|c| DVec3::new((c / 2) as f64 * STRIP_STEP, (c % 2) as f64, 0.0)).collect();
         let mut columns = Columns::rising(&bottoms, Some(LayerSpec::fixed(0.1, 1.2, 10)));
@@ -1221,6 +1246,7 @@ mod tests {
                     }
                 }
             }
+            stop_at_caps(&mut columns, caps, &mut pit, k);
             grade_around_pits(&mut columns, &front, &mut pit, k);
             for c in 0..16 {
                 columns.layers[c] += u32::from(columns.alive[c]);
@@ -1232,7 +1258,7 @@ mod tests {
     #[test]
     fn stacks_around_a_stack_with_no_layer_open_it_into_a_cone() {
         let spec = LayerSpec::fixed(0.1, 1.2, 10);
-        let layers = strip_marched_around(0, false);
+        let layers = strip_marched_around(0, false, &[]);
         for i in 1..layers.len() {
             // The thickest stack within the slope over its neighbour towards the pit, or full.
             let thickness = |n: u32| spec.distance(n);
@@ -1244,8 +1270,20 @@ mod tests {
         // A stack that stopped with layers leaves no pit to the wall, nor one that ended at
         // isotropy (`count = "auto"` over a wall faceted finer than the first layer): its
         // neighbours go on.
-        assert_eq!(strip_marched_around(4, false), [4, 10, 10, 10, 10, 10, 10, 10]);
-        assert_eq!(strip_marched_around(0, true), [0, 10, 10, 10, 10, 10, 10, 10]);
+        assert_eq!(strip_marched_around(4, false, &[]), [4, 10, 10, 10, 10, 10, 10, 10]);
+        assert_eq!(strip_marched_around(0, true, &[]), [0, 10, 10, 10, 10, 10, 10, 10]);
+    }
+
+    #[test]
+    fn a_capped_stack_stops_at_its_cap_and_a_deep_one_opens_into_a_cone() {
+        let never = 11;
+        let mut caps = vec![never; 16];
+        caps[6] = 9;
+        assert_eq!(strip_marched_around(10, false, &caps), [10, 10, 10, 9, 10, 10, 10, 10]);
+        // One layer (0.1 thick) under neighbours 0.25 away: they stop before they rise above
+        // 0.1 + 3 * 0.25 (5 layers, 0.74), theirs in turn above 0.74 + 0.75 (7 layers).
+        caps[6] = 1;
+        assert_eq!(strip_marched_around(10, false, &caps), [8, 7, 5, 1, 5, 7, 8, 9]);
     }
 
     #[test]

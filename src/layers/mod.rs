@@ -19,6 +19,8 @@ pub mod split;
 pub mod swap;
 pub mod unfold;
 
+use std::collections::HashMap;
+
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
 use crate::normals::constraint::Slide;
@@ -62,6 +64,9 @@ pub struct Layers {
     /// ([`LayerSettings::first_aspect`](crate::config::LayerSettings::first_aspect)), or graded
     /// from such a place or from a patch with a smaller one.
     pub lowered_first_heights: Vec<(u32, f64)>,
+    /// The stack under every node of the final front: its wall vertex and layers (the fewest
+    /// of the columns carried there).
+    pub top_stacks: HashMap<u32, (u32, u32)>,
 }
 
 /// Extrude the wall. `patch_spec[p]` is the layer stack of patch `p`, `None` for patches
@@ -73,10 +78,11 @@ pub fn build_layers(
     normals: &WallNormals,
     patch_spec: &[Option<LayerSpec>],
     adapt: Adapt,
+    caps: &[u32],
     mut on_layer: impl FnMut(u32, u32),
 ) -> Layers {
     let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
-    let start = MarchStart { surface, topology, normals, patch_spec, adapt };
+    let start = MarchStart { surface, topology, normals, patch_spec, adapt, caps };
     let mut fitted = vec![false; surface.points.len()];
     let mut marched = start.march(&fitted, &mut on_layer);
     // Stacks stopped short where the first layer is too tall for the wall's facets: march
@@ -136,6 +142,22 @@ pub fn build_layers(
     }
     stopped_vertices.sort_unstable();
     stopped_vertices.dedup();
+    let mut top_stacks: HashMap<u32, (u32, u32)> = HashMap::new();
+    for c in 0..columns.len() {
+        let carrier = columns.carrier(c);
+        if columns.spec[carrier].is_none() || columns.layers[carrier] == 0 {
+            continue;
+        }
+        let stack = (columns.wall_vertex[carrier], columns.layers[carrier]);
+        top_stacks
+            .entry(columns.node[carrier])
+            .and_modify(|s| {
+                if stack.1 < s.1 {
+                    *s = stack;
+                }
+            })
+            .or_insert(stack);
+    }
     let limited = gap::gap_limited(surface, topology, &columns, &mesh.points, &stopped_vertices);
     let (gap_limited_vertices, stopped_vertices) =
         stopped_vertices.into_iter().partition(|&v| limited[v as usize]);
@@ -150,6 +172,7 @@ pub fn build_layers(
         smoothness,
         unfold,
         lowered_first_heights,
+        top_stacks,
     }
 }
 
@@ -163,6 +186,8 @@ struct MarchStart<'a> {
     normals: &'a WallNormals,
     patch_spec: &'a [Option<LayerSpec>],
     adapt: Adapt<'a>,
+    /// Most layers of every wall vertex's stack (`u32::MAX`: its full count).
+    caps: &'a [u32],
 }
 
 /// A march's result, before the front is unfolded and the layers are counted.
@@ -202,9 +227,16 @@ impl<'a> MarchStart<'a> {
         let mut sizes =
             split::Sizes::new(self.adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
         let walls = entropy::VertexWalls::new(surface, self.topology, layered);
-        let stats = march::march(&mut mesh, &mut columns, &mut front, max_layers, &mut sizes, &walls, |k| {
-            on_layer(k, max_layers)
-        });
+        let stats = march::march(
+            &mut mesh,
+            &mut columns,
+            &mut front,
+            max_layers,
+            &mut sizes,
+            &walls,
+            self.caps,
+            |k| on_layer(k, max_layers),
+        );
         Marched { mesh, columns, front, sizes, stats, lowered_first_heights }
     }
 }

@@ -387,3 +387,27 @@ fn a_cavity_grown_across_its_flat_faces_beats_the_delaunay_one() {
     }
     assert!(better > 0, "no grown cavity did better in {tried} insertions");
 }
+
+/// An octahedron (its six corners fixed) split around an added point near corner +x: the point
+/// merged into that corner leaves the four tetrahedra from it over the far faces, better than
+/// the slivers at the point; the point is gone from the parts, and a fixed point never merges.
+#[test]
+fn an_added_point_near_a_corner_merges_into_it() {
+    let corners = [DVec3::X, -DVec3::X, DVec3::Y, -DVec3::Y, DVec3::Z, -DVec3::Z];
+    let mut points = corners.to_vec();
+    points.push(DVec3::new(0.9, 0.0, 0.02));
+    let faces = [[0, 2, 4], [2, 1, 4], [1, 3, 4], [3, 0, 4], [2, 0, 5], [1, 2, 5], [3, 1, 5], [0, 3, 5]];
+    let tets = faces.iter().map(|&[a, b, c]| [a, c, b, 6]).collect();
+    let mut mesh = TetMesh::new(points, tets, 6);
+    let reference = mesh.clone();
+    assert!(mesh.tets().all(|t| mesh.quality(t) > 0.0), "positive to start with");
+    assert!(mesh.collapse_edge(0, 6).is_none(), "corner 0 is fixed");
+    let change = mesh.collapse_edge(6, 0).expect("the octahedron is convex");
+    assert_eq!((change.remove.len(), change.add.len()), (8, 4));
+    assert!(change.after > change.before + 10.0, "{} -> {}", change.before, change.after);
+    mesh.apply(&change);
+    assert_consistent(&mesh, &reference);
+    let (points, tets) = mesh.into_parts();
+    assert_eq!((points.len(), tets.len()), (6, 4));
+    assert!(tets.iter().all(|t| t.contains(&0)));
+}
