@@ -209,6 +209,7 @@ pub fn run(
         progress: &progress,
     };
     let (Round { layered, mesh, core, .. }, peel) = stages.run_peeling(&mut timings)?;
+    warnings.extend(peel.failed_round.clone());
     let layer_summary = layer_summary(&layered, &surface, &topology, &features);
     let check = timings.time("check", || quality::check(&mesh));
     if !check.is_valid() {
@@ -267,6 +268,8 @@ pub struct PeelStats {
     pub kept_round: usize,
     /// Wall vertices whose stack was capped a layer under its top in the kept round's march.
     pub capped_vertices: usize,
+    /// Why a round failed (the layers or the core), when one did: the best before it is kept.
+    pub failed_round: Option<String>,
 }
 
 impl LayersAndCore<'_> {
@@ -282,7 +285,16 @@ impl LayersAndCore<'_> {
         let mut best: Option<Round> = None;
         let mut kept_caps = 0;
         for round in 0..=self.config.peel_rounds() {
-            let this = self.round(&caps, timings)?;
+            let this = match self.round(&caps, timings) {
+                Ok(this) => this,
+                // A later round that fails leaves the best so far.
+                Err(e) if best.is_some() => {
+                    stats.failed_round =
+                        Some(format!("peeling round {round} failed, an earlier one kept: {e}"));
+                    break;
+                }
+                Err(e) => return Err(e),
+            };
             stats.slivers_by_round.push(this.slivers.tets.len());
             let front_nodes = this.layered.top_stacks.len() as f64;
             let peelable = this.slivers.tets.len() as f64 <= PEEL_MAX_SLIVER_SHARE * front_nodes;
