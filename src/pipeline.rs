@@ -420,16 +420,23 @@ impl SliverScore {
             || (self.tets.len() == other.tets.len() && self.worst > other.worst)
     }
 
-    /// Cap the stacks under the slivers' front nodes a layer under their top (a stack keeps
-    /// one layer at least: none would leave a pit). Returns how many caps were lowered.
+    /// Cap the tallest stacks under each sliver's front nodes (those that reached the most
+    /// layers) a layer under their top; a stack keeps one layer at least (none would leave a
+    /// pit). Returns how many caps were lowered. (Every front node's stack instead: spot's
+    /// coverage 87.3-88.1% in 6-8 rounds over growth 1.1999 / 1.2 / 1.2001; the tallest alone:
+    /// 88.5-89.7% in 4-5.)
     fn lower_caps(&self, layered: &layers::Layers, caps: &mut [u32]) -> usize {
         let mut lowered = 0;
-        for node in self.tets.iter().flatten() {
-            let Some(&(v, reached)) = layered.top_stacks.get(node) else { continue };
-            let cap = &mut caps[v as usize];
-            if reached >= 2 && reached - 1 < *cap {
-                *cap = reached - 1;
-                lowered += 1;
+        for tet in &self.tets {
+            let stacks: Vec<(u32, u32)> =
+                tet.iter().filter_map(|n| layered.top_stacks.get(n).copied()).collect();
+            let Some(tallest) = stacks.iter().map(|s| s.1).max() else { continue };
+            for (v, reached) in stacks.into_iter().filter(|s| s.1 == tallest) {
+                let cap = &mut caps[v as usize];
+                if reached >= 2 && reached - 1 < *cap {
+                    *cap = reached - 1;
+                    lowered += 1;
+                }
             }
         }
         lowered
