@@ -402,19 +402,11 @@ impl TetMesh {
         self.tets.iter().zip(&self.alive).filter(|(_, &a)| a).map(|(t, _)| *t)
     }
 
-    /// The points and live tetrahedra; points an edge collapse removed are dropped (the
-    /// fixed points keep their indices).
+    /// The points (also those an edge collapse left unused: [`super::merge::drop_unused_points`])
+    /// and the live tetrahedra.
     pub fn into_parts(self) -> (Vec<DVec3>, Vec<[u32; 4]>) {
-        let mut index = vec![u32::MAX; self.points.len()];
-        let mut points = Vec::with_capacity(self.points.len());
-        for (v, p) in self.points.iter().enumerate() {
-            if v < self.fixed || !self.ball[v].is_empty() {
-                index[v] = points.len() as u32;
-                points.push(*p);
-            }
-        }
-        let tets = self.tets().map(|t| t.map(|v| index[v as usize])).collect();
-        (points, tets)
+        let tets = self.tets().collect();
+        (self.points, tets)
     }
 
     fn corners(&self, tet: [u32; 4]) -> [DVec3; 4] {
@@ -609,15 +601,12 @@ impl TetMesh {
         if add.len() == remove.len() {
             return None;
         }
-        let volume = |tets: &mut dyn Iterator<Item = [u32; 4]>| {
-            tets.map(|t| {
-                let [p, q, r, s] = self.corners(t);
-                crate::geometry::tet_signed_volume(p, q, r, s)
-            })
-            .sum::<f64>()
+        let volume = |t: [u32; 4]| {
+            let [p, q, r, s] = self.corners(t);
+            crate::geometry::tet_signed_volume(p, q, r, s)
         };
-        let old = volume(&mut remove.iter().map(|&t| self.tets[t as usize]));
-        let new = volume(&mut add.iter().copied());
+        let old: f64 = remove.iter().map(|&t| volume(self.tets[t as usize])).sum();
+        let new: f64 = add.iter().map(|&t| volume(t)).sum();
         if (new - old).abs() > 1e-9 * old {
             return None;
         }
@@ -1421,7 +1410,8 @@ pub fn improve_core(
     };
     let mesher_min_dihedral = worst(&core.points, &core.tets);
     let mesher_histogram = DihedralHistogram::of(&core.points, &core.tets);
-    let mut mesh = TetMesh::new(core.points, core.tets, fixed.max(boundary.points.len()));
+    let fixed = fixed.max(boundary.points.len());
+    let mut mesh = TetMesh::new(core.points, core.tets, fixed);
     let front_height = boundary
         .triangles
         .iter()
@@ -1437,7 +1427,9 @@ pub fn improve_core(
     let (points, tets) = mesh.into_parts();
     let n = boundary.points.len();
     boundary.points.copy_from_slice(&points[..n]);
-    let core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };
+    let mut core = CoreTets { points, tets, boundary_steiner_points: core.boundary_steiner_points };
+    // The points edge collapses removed.
+    super::merge::drop_unused_points(&mut core, fixed);
     let quality = CoreQuality {
         mesher_min_dihedral,
         mesher_histogram,
