@@ -14,6 +14,7 @@ pub mod validity;
 
 pub use report::*;
 
+use crate::mesh::faces::FaceUses;
 use crate::mesh::{CellKind, VolumeMesh};
 
 /// Check a volume mesh: counts, validity, conformity, volume identity and quality.
@@ -26,7 +27,7 @@ pub fn check(mesh: &VolumeMesh) -> CheckReport {
     }
     let (blocks, (conformity, enclosed)) = rayon::join(
         || CellKind::ALL.map(|kind| validity::check_block(mesh, kind)),
-        || conformity::check_faces(mesh),
+        || conformity::check_faces(mesh, &FaceUses::new(mesh)),
     );
     let mut volume = 0.0;
     for (kind, block) in CellKind::ALL.into_iter().zip(blocks) {
