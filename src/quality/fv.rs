@@ -237,3 +237,115 @@ pub fn measure(mesh: &VolumeMesh, table: &FaceTable) -> FvReport {
     let all = cells.par_iter().fold(FvTally::default, |tally, c| tally.add_cell(c));
     faces.chain(all).reduce(FvTally::default, FvTally::merge).finish()
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::quality::check;
+    use crate::quality::fv_report::WORST_FACES as WORST;
+    use crate::quality::samples::{cube_grid, CubeSplit};
+
+    fn measures_of(mesh: &VolumeMesh) -> (FaceTable, Vec<FaceMeasures>) {
+        let table = FaceTable::new(mesh);
+        let cells = cell_geometries(mesh);
+        let faces = (0..table.len()).map(|f| face_measures(mesh, &table, &cells, f)).collect();
+        (table, faces)
+    }
+
+    fn close(a: f64, b: f64) -> bool {
+        (a - b).abs() <= 1e-12 * (1.0 + b.abs())
+    }
+
+    #[test]
+    fn a_unit_cube_grid_is_orthogonal_and_unskewed() {
+        let mesh = cube_grid([3, 2, 2], DVec3::ONE, &|_| CubeSplit::Hexahedron, &|_| 0);
+        let r = check(&mesh).fv;
+        assert_eq!((r.faces, r.interior_faces, r.boundary_faces), (52, 20, 32));
+        assert!(r.non_orthogonality_max < 1e-6 && r.boundary_non_orthogonality_max < 1e-6, "{r}");
+        assert!(r.skewness_max < 1e-12 && r.wrong_face_pyramids == 0, "{r}");
+        assert!(
+            r.cell_openness_max < 1e-15 && close(r.aspect_ratio_max, 1.0) && close(r.face_flatness_min, 1.0)
+        );
+        assert!(close(r.cell_volume_min, 1.0) && r.rejection().is_none());
+        assert_eq!(r.non_orthogonality_by_kinds["hexahedron-hexahedron"].faces, 20);
+    }
+
+    #[test]
+    fn a_unit_cube_has_the_centre_and_volume_of_its_pyramids() {
+        let mesh = cube_grid([1, 1, 1], DVec3::new(2.0, 1.0, 1.0), &|_| CubeSplit::Hexahedron, &|_| 0);
+        let c = cell_geometries(&mesh)[0];
+        assert!(close(c.volume, 2.0) && (c.centre - DVec3::new(1.0, 0.5, 0.5)).length() < 1e-15);
+        // Areas seen along the axes 2, 4, 4: 4 / 2 beats (2 + 4 + 4) / (6 * 2^(2/3)).
+        assert!(close(c.aspect_ratio, 2.0), "{}", c.aspect_ratio);
+    }
+
+    /// Two unit cubes along x, the far face moved by `shift`.
+    fn hexahedral_pair(shift: DVec3) -> VolumeMesh {
+        let mut mesh = cube_grid([2, 1, 1], DVec3::ONE, &|_| CubeSplit::Hexahedron, &|_| 0);
+        for p in mesh.points.iter_mut().filter(|p| p.x == 2.0) {
+            *p += shift;
+        }
+        mesh
+    }
+
+    #[test]
+    fn a_sheared_hexahedral_pair_has_the_angle_of_its_centre_line() {
+        // Cell 1 is a parallelepiped: centre (1.5, 1, 0.5), so d = (1, 0.5, 0) against the normal x.
+        let (table, faces) = measures_of(&hexahedral_pair(DVec3::new(0.0, 1.0, 0.0)));
+        assert_eq!(table.interior_count(), 1);
+        let shared = faces[0];
+        assert!(close(shared.non_orthogonality, 0.5f64.atan().to_degrees()), "{shared:?}");
+        // The centre line crosses x = 1 at y = 0.75: 0.25 from the face centre, over its half width.
+        assert!(close(shared.skewness, 0.5), "{shared:?}");
+        assert!(!shared.wrong_pyramid);
+    }
+
+    #[test]
+    fn a_face_tilted_along_the_centre_line_is_non_orthogonal_but_not_skewed() {
+        // x' = x + z tan 30 deg: the shared face tilts by 30 deg, the centre line stays along x.
+        let mut mesh = cube_grid([2, 1, 1], DVec3::ONE, &|_| CubeSplit::Hexahedron, &|_| 0);
+        let t = 30f64.to_radians().tan();
+        mesh.points.iter_mut().for_each(|p| p.x += t * p.z);
+        let (_, faces) = measures_of(&mesh);
+        assert!(close(faces[0].non_orthogonality, 30.0) && faces[0].skewness < 1e-12, "{:?}", faces[0]);
+    }
+
+    /// Tetrahedra (a, b, c, top) and (a, c, b, bottom) on the triangle a b c in z = 0.
+    fn tetrahedron_pair(bottom: DVec3) -> VolumeMesh {
+        let mut mesh = VolumeMesh { zone_names: vec!["fluid".into()], ..Default::default() };
+        mesh.points = vec![DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z, bottom];
+        mesh.push_cell(CellKind::Tetrahedron, &[0, 1, 2, 3], 0);
+        mesh.push_cell(CellKind::Tetrahedron, &[0, 2, 1, 4], 0);
+        mesh
+    }
+
+    #[test]
+    fn a_tetrahedron_pair_is_orthogonal_with_a_known_skewness() {
+        let (table, faces) = measures_of(&tetrahedron_pair(-DVec3::Z));
+        assert_eq!((table.len(), table.interior_count()), (7, 1));
+        // Centres (1/4, 1/4, +-1/4) cross z = 0 at (1/4, 1/4), 1/12 sqrt 2 from the face centre
+        // (1/3, 1/3); the face reaches 2/3 sqrt 2 / 2 from its centre that way.
+        assert!(faces[0].non_orthogonality < 1e-6 && close(faces[0].skewness, 0.25), "{:?}", faces[0]);
+        assert!(faces.iter().all(|f| !f.wrong_pyramid));
+    }
+
+    #[test]
+    fn an_inverted_face_pyramid_is_counted_and_rejected() {
+        // The second tetrahedron's apex is above the shared face: its centre is on the owner's side.
+        let mesh = tetrahedron_pair(DVec3::new(0.0, 0.0, 0.5));
+        let (_, faces) = measures_of(&mesh);
+        assert!(faces[0].wrong_pyramid, "{:?}", faces[0]);
+        let r = check(&mesh).fv;
+        assert!(r.wrong_face_pyramids >= 1 && r.rejection().is_some(), "{r}");
+        assert_eq!(r.wrong_pyramid_examples.len(), r.wrong_face_pyramids.min(WORST));
+    }
+
+    #[test]
+    fn a_warped_quad_is_less_flat_than_a_plane_one() {
+        let flat = face_geometry(&[DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y]);
+        assert!(close(flat.flatness(), 1.0) && close(flat.area.z, 1.0));
+        assert!((flat.centre - DVec3::new(0.5, 0.5, 0.0)).length() < 1e-15);
+        let warped = face_geometry(&[DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 1.0), DVec3::Y]);
+        assert!(warped.flatness() < 0.99);
+    }
+}
