@@ -160,6 +160,7 @@ pub fn face_measures(mesh: &VolumeMesh, table: &FaceTable, cells: &[CellGeometry
         Some(n) => n - owner,
         None => face.area.normalize_or_zero() * face.area.normalize_or_zero().dot(owner_to_face),
     };
+    // Negated so a NaN (a point out of range) counts as wrong.
     let wrong_owner = !(face.area.dot(owner_to_face) > 0.0);
     let wrong_neighbour = neighbour.is_some_and(|n| !(face.area.dot(face.centre - n) < 0.0));
     let across = if neighbour.is_some() { d } else { owner_to_face };

@@ -7,6 +7,7 @@ use blmesh::surface::{shapes, Surface};
 
 /// A 2 x 1 x 1.5 box (3 divisions per edge) and 5 layers of h0 = 0.01, r = 1.2: its layers have
 /// every cell kind (prisms, fans of hexahedra, pyramids and tetrahedra at the corners).
+#[allow(dead_code)] // not every test crate meshes the box
 pub fn layered_box() -> (Surface, Config) {
     let surface = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 3);
     let layers = LayerSettings {
