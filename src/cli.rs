@@ -45,8 +45,9 @@ enum Command {
         #[arg(long, default_value_t = crate::config::DEFAULT_FEATURE_ANGLE)]
         feature_angle: f64,
     },
-    /// Check a volume mesh (.msh, .vtu): positive volumes, conformity, volume identity, quality.
-    /// Exits with 0 only when the mesh is valid.
+    /// Check a volume mesh (.msh, .vtu): positive volumes, conformity, volume identity, quality,
+    /// finite-volume measures. Exits with 0 only when the mesh is valid and a finite-volume solver
+    /// would accept it (no wrong face pyramid, no face at 90 degrees non-orthogonality or more).
     Check {
         mesh: PathBuf,
         /// Print JSON instead of text.
@@ -213,7 +214,8 @@ fn check(path: &Path, json: bool) -> Result<ExitCode> {
     } else {
         print_out(&format!("{}\n{report}", path.display()));
     }
-    Ok(if report.is_valid() { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
+    let accepted = report.is_valid() && report.fv.rejection().is_none();
+    Ok(if accepted { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
 }
 
 /// The role of every patch of the mesh: the config's, except that a patch the config leaves a

@@ -733,6 +733,12 @@ impl std::fmt::Display for MeshReport {
             }
         }
         writeln!(f, "quality   worst scaled Jacobian {:.3}", worst_scaled_jacobian(&self.check))?;
+        let v = &self.check.fv;
+        writeln!(
+            f,
+            "fv        non-orthogonality max {:.1} mean {:.1} deg ({} faces above 70, {} above 80), skewness max {:.2}, {} wrong face pyramids",
+            v.non_orthogonality_max, v.non_orthogonality_mean, v.faces_above_70, v.faces_above_80, v.skewness_max, v.wrong_face_pyramids
+        )?;
         for w in &self.warnings {
             writeln!(f, "warning   {w}")?;
         }

@@ -24,7 +24,11 @@
 //!
 //! Faces of each kind, oriented outward, are in [`CellKind::faces`].
 
+pub mod faces;
+
 use crate::geometry::DVec3;
+
+pub use faces::{Across, CellNumbering, FaceTable};
 
 /// An edge as its two node ids, smaller first: the key of an edge whichever way it is walked.
 pub fn sorted_edge(a: u32, b: u32) -> [u32; 2] {

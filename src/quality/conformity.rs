@@ -5,21 +5,11 @@
 //! when the mesh lists no boundary faces at all, the free faces are taken as its boundary. The
 //! volume enclosed by the free faces is summed here too, for the volume identity.
 
-use rayon::prelude::*;
-
 use super::measures::face_triangles;
 use super::report::{BoundaryRef, CellRef, Conformity, FaceIssue, FaceProblem};
 use crate::geometry::{Aabb, DVec3};
+use crate::mesh::faces::{sorted, CellNumbering, FaceUse, FaceUses};
 use crate::mesh::{CellKind, VolumeMesh};
-
-/// One use of a face: by a cell (`owner` < cell count, `local` face) or by a boundary face
-/// (`owner` = cell count + its index). `key` is the sorted vertex set.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord)]
-struct FaceUse<const N: usize> {
-    key: [u32; N],
-    owner: u32,
-    local: u8,
-}
 
 /// How two uses of the same vertex set are oriented relative to each other.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -59,30 +49,18 @@ fn relation<const N: usize>(a: [u32; N], b: [u32; N]) -> Relation {
     }
 }
 
-fn sorted<const N: usize>(mut face: [u32; N]) -> [u32; N] {
-    face.sort_unstable();
-    face
-}
-
 /// The mesh seen as face owners.
 struct Owners<'a, const N: usize> {
     mesh: &'a VolumeMesh,
-    /// Global index of the first cell of each block, and the cell count at the end.
-    starts: [usize; 5],
+    numbering: CellNumbering,
     boundary: &'a [[u32; N]],
+    /// Every use of an N-vertex face, sorted.
+    uses: &'a [FaceUse<N>],
 }
 
 impl<'a, const N: usize> Owners<'a, N> {
-    fn new(mesh: &'a VolumeMesh, boundary: &'a [[u32; N]]) -> Self {
-        let mut starts = [0; 5];
-        for (i, kind) in CellKind::ALL.into_iter().enumerate() {
-            starts[i + 1] = starts[i] + mesh.block(kind).nodes.len() / kind.node_count();
-        }
-        Owners { mesh, starts, boundary }
-    }
-
     fn cell_count(&self) -> usize {
-        self.starts[4]
+        self.numbering.cell_count()
     }
 
     fn is_cell(&self, owner: u32) -> bool {
@@ -90,9 +68,8 @@ impl<'a, const N: usize> Owners<'a, N> {
     }
 
     fn cell(&self, owner: u32) -> CellRef {
-        let g = owner as usize;
-        let k = (0..4).rfind(|&k| self.starts[k] <= g).unwrap_or(0);
-        CellRef { kind: CellKind::ALL[k], index: g - self.starts[k] }
+        let (kind, index) = self.numbering.locate(owner as usize);
+        CellRef { kind, index }
     }
 
     fn boundary_index(&self, owner: u32) -> usize {
@@ -104,37 +81,9 @@ impl<'a, const N: usize> Owners<'a, N> {
         if !self.is_cell(u.owner) {
             return self.boundary[self.boundary_index(u.owner)];
         }
-        let CellRef { kind, index } = self.cell(u.owner);
-        let n = kind.node_count();
-        let nodes = &self.mesh.block(kind).nodes[index * n..(index + 1) * n];
-        let local = kind.faces()[u.local as usize];
+        let nodes = self.numbering.nodes(self.mesh, u.owner as usize);
+        let local = self.cell(u.owner).kind.faces()[u.local as usize];
         std::array::from_fn(|i| nodes[local[i]])
-    }
-
-    /// Every use of an N-vertex face, sorted.
-    fn uses(&self) -> Vec<FaceUse<N>> {
-        let mut uses: Vec<FaceUse<N>> = Vec::new();
-        for (k, kind) in CellKind::ALL.into_iter().enumerate() {
-            let start = self.starts[k];
-            let cells = self.mesh.block(kind).nodes.par_chunks_exact(kind.node_count());
-            uses.par_extend(cells.enumerate().flat_map_iter(move |(i, cell)| {
-                let owner = (start + i) as u32;
-                let faces = kind.faces().iter().enumerate().filter(|(_, f)| f.len() == N);
-                faces.map(move |(local, f)| FaceUse {
-                    key: sorted(std::array::from_fn(|j| cell[f[j]])),
-                    owner,
-                    local: local as u8,
-                })
-            }));
-        }
-        let first = self.cell_count();
-        uses.extend(self.boundary.iter().enumerate().map(|(i, f)| FaceUse {
-            key: sorted(*f),
-            owner: (first + i) as u32,
-            local: 0,
-        }));
-        uses.par_sort_unstable();
-        uses
     }
 
     fn issue(&self, problem: FaceProblem, group: &[FaceUse<N>]) -> FaceIssue {
@@ -173,7 +122,7 @@ struct Scan<const N: usize> {
 
 /// Classify every group of uses of the same vertex set.
 fn scan<const N: usize>(owners: &Owners<N>, origin: DVec3, report: &mut Conformity) -> Scan<N> {
-    let uses = owners.uses();
+    let uses = owners.uses;
     let mut out = Scan { unmatched: Vec::new(), free: Vec::new(), enclosed: 0.0 };
     for group in uses.chunk_by(|a, b| a.key == b.key) {
         let split = group.partition_point(|u| owners.is_cell(u.owner));
@@ -269,11 +218,12 @@ pub fn owner_ids_fit(mesh: &VolumeMesh) -> bool {
 }
 
 /// Conformity of the mesh's faces and the volume enclosed by its free faces.
-pub fn check_faces(mesh: &VolumeMesh) -> (Conformity, f64) {
+pub(crate) fn check_faces(mesh: &VolumeMesh, uses: &FaceUses) -> (Conformity, f64) {
     let mut report = Conformity::default();
     let b = &mesh.boundary;
-    let tris = Owners::new(mesh, &b.triangles);
-    let quads = Owners::new(mesh, &b.quads);
+    let numbering = uses.numbering;
+    let tris = Owners { mesh, numbering, boundary: &b.triangles, uses: &uses.triangles };
+    let quads = Owners { mesh, numbering, boundary: &b.quads, uses: &uses.quads };
     let origin = Aabb::from_points(&mesh.points).center();
     let mut tri_scan = scan(&tris, origin, &mut report);
     let mut quad_scan = scan(&quads, origin, &mut report);

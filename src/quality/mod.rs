@@ -6,14 +6,18 @@
 //! the cells with the definitions of `shared/bench/measure.py` ([`measures`]).
 
 mod conformity;
+pub mod fv;
+mod fv_report;
 pub mod measures;
 pub mod overlap;
 mod report;
 pub mod samples;
 pub mod validity;
 
+pub use fv_report::{FvReport, LocatedFace, PairNonOrthogonality};
 pub use report::*;
 
+use crate::mesh::faces::{FaceTable, FaceUses};
 use crate::mesh::{CellKind, VolumeMesh};
 
 /// Check a volume mesh: counts, validity, conformity, volume identity and quality.
@@ -24,10 +28,15 @@ pub fn check(mesh: &VolumeMesh) -> CheckReport {
         report.structure_errors.push("too many cells and boundary faces for 32-bit face owners".into());
         return report;
     }
-    let (blocks, (conformity, enclosed)) = rayon::join(
+    let (blocks, faces) = rayon::join(
         || CellKind::ALL.map(|kind| validity::check_block(mesh, kind)),
-        || conformity::check_faces(mesh),
+        || {
+            let uses = FaceUses::new(mesh);
+            let table = FaceTable::from_uses(mesh, &uses);
+            rayon::join(|| conformity::check_faces(mesh, &uses), || fv::measure(mesh, &table))
+        },
     );
+    let ((conformity, enclosed), fv) = faces;
     let mut volume = 0.0;
     for (kind, block) in CellKind::ALL.into_iter().zip(blocks) {
         report.validity.append(block.validity);
@@ -41,6 +50,7 @@ pub fn check(mesh: &VolumeMesh) -> CheckReport {
         ));
     }
     report.conformity = conformity;
+    report.fv = fv;
     report.volume =
         VolumeCheck { cells: volume, enclosed, relative_difference: relative_difference(volume, enclosed) };
     report.overlap = overlap::boundary_overlap(mesh);

@@ -290,6 +290,8 @@ pub struct CheckReport {
     pub overlap: super::overlap::Overlap,
     /// Quality of the cells whose nodes are in range (invalid cells included).
     pub quality: PerKind<KindQuality>,
+    /// Finite-volume measures (what OpenFOAM's checkMesh reports).
+    pub fv: super::FvReport,
 }
 
 impl CheckReport {
@@ -351,6 +353,7 @@ impl fmt::Display for CheckReport {
             }
         }
         write_quality(&self.quality, f)?;
+        write!(f, "{}", self.fv)?;
         writeln!(f, "{}", if self.is_valid() { "VALID" } else { "INVALID" })
     }
 }

@@ -317,6 +317,50 @@ proptest! {
     }
 }
 
+proptest! {
+    #![proptest_config(ProptestConfig::with_cases(32))]
+
+    /// The face-pyramid cells of the finite-volume measures fill the box exactly, and a valid
+    /// grid has no wrong face pyramid and no open cell.
+    #[test]
+    fn finite_volume_cells_add_up_to_the_mesh_volume(
+        dims in proptest::array::uniform3(1usize..=3),
+        spacing in proptest::array::uniform3(0.01f64..100.0),
+        splits in proptest::collection::vec(0usize..4, 27),
+        seed in 1u64..u64::MAX,
+    ) {
+        let mesh = shuffle(&random_grid(dims, spacing, &splits), &mut Rng(seed));
+        let cells = super::fv::cell_geometries(&mesh);
+        let sum: f64 = cells.iter().map(|c| c.volume).sum();
+        let box_volume = dims.iter().zip(spacing).map(|(&n, h)| n as f64 * h).product::<f64>();
+        prop_assert!((sum - box_volume).abs() <= 1e-12 * box_volume, "{sum} against {box_volume}");
+        let fv = check(&mesh).fv;
+        prop_assert_eq!(fv.wrong_face_pyramids, 0);
+        prop_assert!(fv.non_orthogonality_max < 90.0 && fv.cell_openness_max < 1e-12, "{}", fv);
+        prop_assert_eq!(fv.faces, crate::mesh::FaceTable::new(&mesh).len());
+    }
+}
+
+#[test]
+fn the_report_serialises_the_finite_volume_measures() {
+    let json = serde_json::to_value(check(&hybrid_column())).unwrap();
+    let fv = &json["fv"];
+    for key in [
+        "faces",
+        "non_orthogonality_max",
+        "non_orthogonality_mean",
+        "faces_above_70",
+        "faces_above_80",
+        "skewness_max",
+        "faces_skewness_above_4",
+        "wrong_face_pyramids",
+        "worst_non_orthogonality",
+    ] {
+        assert!(fv.get(key).is_some(), "no fv.{key} in {fv}");
+    }
+    assert!(fv["worst_skewness"][0]["centre"].is_array() && fv["worst_skewness"][0]["owner"].is_string());
+}
+
 /// `cargo test --release -- --ignored one_million_cells --nocapture` prints the time to check
 /// about a million cells of every kind.
 #[test]
