@@ -201,3 +201,27 @@ fn first_number(text: &str) -> Option<f64> {
         .parse()
         .ok()
 }
+
+/// Our own finite-volume figures (`quality::fv`, from a run's `--report` JSON under
+/// `check.fv`) beside checkMesh's: max non-orthogonality within 0.1 degree, the count of faces
+/// above 70 degrees within 1% (at least one face). The differences, or why they disagree.
+pub fn compare_fv(report_json: &str, check: &CheckMesh) -> Result<String, String> {
+    let report: serde_json::Value = serde_json::from_str(report_json).map_err(|e| e.to_string())?;
+    let fv = &report["check"]["fv"];
+    let max = fv["non_orthogonality_max"].as_f64().ok_or("no check.fv.non_orthogonality_max")?;
+    let above = fv["faces_above_70"].as_u64().ok_or("no check.fv.faces_above_70")? as usize;
+    let skew = fv["skewness_max"].as_f64().unwrap_or(f64::NAN);
+    let text = format!(
+        "ours: max non-orthogonality {max:.3} deg, {above} faces > 70, max skewness {skew:.3}; \
+         checkMesh: {:.3} deg, {}, {:.3}",
+        check.max_non_orthogonality, check.severely_non_orthogonal, check.max_skewness
+    );
+    let count_tolerance = (check.severely_non_orthogonal as f64 * 0.01).ceil().max(1.0) as usize;
+    let agree = (max - check.max_non_orthogonality).abs() <= 0.1
+        && above.abs_diff(check.severely_non_orthogonal) <= count_tolerance;
+    if agree {
+        Ok(text)
+    } else {
+        Err(text)
+    }
+}
