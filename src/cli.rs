@@ -131,7 +131,8 @@ struct MeshArgs {
     /// Also write the run's report as JSON.
     #[arg(long)]
     report: Option<PathBuf>,
-    /// Also write pictures (PNG) of cuts through the mesh and a quality histogram into DIR.
+    /// Also write pictures (PNG) of cuts through the mesh, a quality histogram and histograms of
+    /// the faces' non-orthogonality by cell kind into DIR.
     #[arg(long, value_name = "DIR")]
     pictures: Option<PathBuf>,
 }

@@ -7,7 +7,8 @@ use rayon::prelude::*;
 use super::cut::gather;
 use super::{cut_picture, histogram_picture, write_png, Colouring, CutPlane, View};
 use crate::geometry::{Aabb, DVec3};
-use crate::mesh::VolumeMesh;
+use crate::mesh::{CellKind, VolumeMesh};
+use crate::quality::fv::non_orthogonality_by_kind;
 use crate::quality::measures::scaled_jacobian;
 
 /// Side of the square cut pictures, in pixels.
@@ -44,6 +45,8 @@ pub struct PictureSpot {
 ///   cell of lowest scaled Jacobian, zoomed on its neighbourhood (4 times its size);
 /// - `quality_histogram.png`: the scaled Jacobians of all cells in 50 bins over [0, 1]
 ///   (invalid cells, <= 0, in the first bin);
+/// - `non_orthogonality_KIND.png` for every kind of cell with interior faces: the
+///   non-orthogonality of the faces touching such cells, 45 bins over [0, 90] degrees;
 /// - `NAME.png`, `NAME_quality.png` for every spot: the cut through it, zoomed to its width.
 pub fn write_overview(mesh: &VolumeMesh, dir: &Path, spots: &[PictureSpot]) -> std::io::Result<Vec<PathBuf>> {
     std::fs::create_dir_all(dir)?;
@@ -75,6 +78,12 @@ pub fn write_overview(mesh: &VolumeMesh, dir: &Path, spots: &[PictureSpot]) -> s
         write("worst_cell_quality.png", &cut_picture(mesh, &plane, &view, Colouring::Quality, SIDE, SIDE))?;
     }
     write("quality_histogram.png", &histogram_picture(&quality, 50, (0.0, 1.0), 1000, 400))?;
+    for (kind, angles) in CellKind::ALL.iter().zip(non_orthogonality_by_kind(mesh)) {
+        if !angles.is_empty() {
+            let picture = histogram_picture(&angles, 45, (0.0, 90.0), 1000, 400);
+            write(&format!("non_orthogonality_{}.png", kind.name()), &picture)?;
+        }
+    }
     Ok(written)
 }
 
@@ -108,7 +117,8 @@ mod tests {
         let written = write_overview(&mesh, &dir.path().join("pictures"), &[spot]).unwrap();
         let names: Vec<_> =
             written.iter().map(|p| p.file_name().unwrap().to_string_lossy().into_owned()).collect();
-        assert_eq!(names.len(), 11, "{names:?}");
+        assert_eq!(names.len(), 15, "{names:?}");
+        assert!(names.contains(&"non_orthogonality_pyramid.png".to_string()));
         assert!(
             names.contains(&"worst_cell.png".to_string()) && names.contains(&"spot_quality.png".to_string())
         );

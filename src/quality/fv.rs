@@ -207,22 +207,23 @@ pub fn face_kinds(table: &FaceTable, numbering: &CellNumbering, f: usize) -> (Ce
     (kind(table.owner(f)), table.neighbour(f).map(kind))
 }
 
-/// The non-orthogonality of the interior faces touching each kind of cell, in degrees: a face
-/// between two kinds counts for both, between two cells of one kind once.
+/// The non-orthogonality of the interior faces touching each kind of cell, in degrees, in
+/// [`CellKind::ALL`] order: a face between two kinds counts for both, between two cells of one
+/// kind once.
 pub fn non_orthogonality_by_kind(mesh: &VolumeMesh) -> [Vec<f64>; 4] {
     let table = FaceTable::new(mesh);
     let numbering = CellNumbering::new(mesh);
     let cells = cell_geometries(mesh);
-    let mut out: [Vec<f64>; 4] = Default::default();
-    for f in 0..table.interior_count() {
-        let value = face_measures(mesh, &table, &cells, f).non_orthogonality;
-        let (a, b) = face_kinds(&table, &numbering, f);
-        out[a as usize].push(value);
-        if let Some(b) = b.filter(|&b| b != a) {
-            out[b as usize].push(value);
-        }
-    }
-    out
+    let faces: Vec<(f64, (CellKind, Option<CellKind>))> = (0..table.interior_count())
+        .into_par_iter()
+        .map(|f| {
+            (face_measures(mesh, &table, &cells, f).non_orthogonality, face_kinds(&table, &numbering, f))
+        })
+        .collect();
+    CellKind::ALL.map(|kind| {
+        let touches = |(a, b): (CellKind, Option<CellKind>)| a == kind || b == Some(kind);
+        faces.iter().filter(|(_, kinds)| touches(*kinds)).map(|(value, _)| *value).collect()
+    })
 }
 
 /// The finite-volume measures of `mesh`, whose faces are `table`.

@@ -371,5 +371,14 @@ fn one_million_cells() {
     let t = std::time::Instant::now();
     let r = check(&mesh);
     println!("{} cells checked in {:.2} s\n{r}", mesh.cell_count(), t.elapsed().as_secs_f64());
+    let t = std::time::Instant::now();
+    let table = crate::mesh::FaceTable::new(&mesh);
+    let table_seconds = t.elapsed().as_secs_f64();
+    let fv = super::fv::measure(&mesh, &table);
+    println!(
+        "face table {table_seconds:.2} s, fv measures {:.2} s",
+        t.elapsed().as_secs_f64() - table_seconds
+    );
+    assert_eq!((fv.faces, fv.non_orthogonality_max), (r.fv.faces, r.fv.non_orthogonality_max));
     assert!(r.is_valid());
 }

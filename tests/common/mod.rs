@@ -2,6 +2,7 @@
 
 use blmesh::config::{Config, LayerCount, LayerSettings};
 use blmesh::geometry::DVec3;
+use blmesh::quality::CheckReport;
 use blmesh::surface::{shapes, Surface};
 
 /// A 2 x 1 x 1.5 box (3 divisions per edge) and 5 layers of h0 = 0.01, r = 1.2: its layers have
@@ -17,4 +18,14 @@ pub fn layered_box() -> (Surface, Config) {
         first_aspect: None,
     };
     (surface, Config { layers, ..Default::default() })
+}
+
+/// The invariants every produced mesh meets: valid for the checker, and nothing a finite-volume
+/// solver would reject (no wrong face pyramid, no face at 90 degrees non-orthogonality or more).
+#[allow(dead_code)] // not every test crate checks meshes
+pub fn assert_valid_for_a_solver(name: &str, check: &CheckReport) {
+    assert!(check.is_valid(), "{name}: {check}");
+    if let Some(why) = check.fv.rejection() {
+        panic!("{name}: {why}\n{}", check.fv);
+    }
 }
