@@ -4,7 +4,9 @@
 # and its tools (libcgns-dev for the cargo feature `cgns`, cgns-convert for cgnscheck and
 # cgns_to_vtk in the tests),
 # the system libraries the Gmsh Python wheel loads, and a venv with gmsh + meshio (used by the
-# interoperability tests that read our files back with other tools). Idempotent.
+# interoperability tests that read our files back with other tools), and OpenFOAM (checkMesh and
+# potentialFoam for tests/foam.rs; its tools find their etc/ through WM_PROJECT_DIR=/usr/share/openfoam,
+# which the tests set, so Debian's noisy etc/bashrc need not be sourced). Idempotent.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -19,6 +21,12 @@ if [ -n "$missing" ]; then
   echo "setup: installing Debian packages:$missing"
   $SUDO apt-get update -qq
   DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq $missing >/dev/null
+fi
+# Without its recommended tutorials (openfoam-examples), which the tests do not use.
+if ! dpkg -s openfoam >/dev/null 2>&1; then
+  echo "setup: installing Debian package: openfoam"
+  $SUDO apt-get update -qq
+  DEBIAN_FRONTEND=noninteractive $SUDO apt-get install -y -qq --no-install-recommends openfoam >/dev/null
 fi
 
 if [ ! -x .venv/bin/python ]; then

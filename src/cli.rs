@@ -86,7 +86,8 @@ struct YplusArgs {
 struct MeshArgs {
     /// Input surface (.stl, .obj, .off, .msh, .mesh, .meshb, .tri, .uh3d).
     input: PathBuf,
-    /// Output mesh; the format follows the extension (.msh, .vtu, .su2, .mesh, .meshb).
+    /// Output mesh; the format follows the extension (.msh, .vtu, .su2, .mesh, .meshb, .cgns), or
+    /// an OpenFOAM polyMesh directory when the last component is `polyMesh`.
     #[arg(short, long)]
     output: PathBuf,
     /// TOML configuration file (flags override it).

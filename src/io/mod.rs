@@ -6,6 +6,7 @@
 
 pub mod cart3d;
 pub mod cgns;
+pub mod foam;
 pub mod medit;
 pub mod msh;
 pub mod obj;
@@ -168,13 +169,18 @@ pub enum MeshFormat {
     },
     /// CGNS (HDF5): one unstructured zone, patches as boundary conditions (feature `cgns`).
     Cgns,
+    /// OpenFOAM polyMesh directory (ASCII), chosen by the output's last component `polyMesh`.
+    Foam,
 }
 
 /// The volume mesh output extensions, for messages.
-pub const MESH_EXTENSIONS: &str = ".msh, .vtu, .su2, .mesh, .meshb, .cgns";
+pub const MESH_EXTENSIONS: &str = ".msh, .vtu, .su2, .mesh, .meshb, .cgns, or a directory named polyMesh";
 
 impl MeshFormat {
     pub fn from_path(path: &Path, ascii: bool) -> Option<Self> {
+        if foam::is_poly_mesh_dir(path) {
+            return Some(MeshFormat::Foam);
+        }
         let ext = path.extension()?.to_str()?.to_ascii_lowercase();
         match ext.as_str() {
             "msh" => Some(MeshFormat::Msh { ascii }),
@@ -212,6 +218,7 @@ pub fn write_volume_mesh_with_roles(
         MeshFormat::Su2 => write_atomic(path, |w| su2::write(w, mesh)),
         MeshFormat::Medit { binary } => write_atomic(path, |w| medit::write_volume(w, mesh, binary)),
         MeshFormat::Cgns => cgns::write(path, mesh, roles),
+        MeshFormat::Foam => foam::write(path, mesh, roles),
     }
 }
 
@@ -242,21 +249,68 @@ pub fn write_atomic_via_path(
     })
 }
 
+/// Write a directory of files atomically: `fill` builds it as a temporary sibling, which is then
+/// renamed over `path` (an older directory there is moved aside first and removed after), so
+/// readers never see a half-written directory. Missing parent directories are created.
+pub fn write_dir_atomic(path: &Path, fill: impl FnOnce(&Path) -> std::io::Result<()>) -> std::io::Result<()> {
+    let parent = parent_dir(path);
+    std::fs::create_dir_all(parent)?;
+    let tmp = temporary_builder(0o777).tempdir_in(parent)?;
+    fill(tmp.path())?;
+    let aside = temporary_builder(0o700).tempdir_in(parent)?;
+    let old = aside.path().join("old");
+    let had_old = match std::fs::rename(path, &old) {
+        Ok(()) => true,
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
+        Err(e) => return Err(e),
+    };
+    if let Err(e) = std::fs::rename(tmp.path(), path) {
+        if had_old {
+            std::fs::rename(&old, path)?;
+        }
+        return Err(e);
+    }
+    let _ = tmp.keep();
+    Ok(())
+}
+
+/// Write one file of a directory being built by [`write_dir_atomic`], synced to disk.
+pub fn write_file_synced(
+    path: &Path,
+    write: impl FnOnce(&mut dyn Write) -> std::io::Result<()>,
+) -> std::io::Result<()> {
+    let mut file = std::fs::File::create(path)?;
+    let mut buffered = std::io::BufWriter::new(&mut file);
+    write(&mut buffered)?;
+    buffered.flush()?;
+    drop(buffered);
+    file.sync_all()
+}
+
+fn parent_dir(path: &Path) -> &Path {
+    match path.parent() {
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
+    }
+}
+
+/// Temporaries are named `.blmesh-*`; `mode` (less the umask) is what the output should get,
+/// not the private mode temporaries get by default.
+fn temporary_builder(mode: u32) -> tempfile::Builder<'static, 'static> {
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(".blmesh-");
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(mode));
+    #[cfg(not(unix))]
+    let _ = mode;
+    builder
+}
+
 fn replace_through_temporary(
     path: &Path,
     fill: impl FnOnce(&mut tempfile::NamedTempFile) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d,
-        _ => Path::new("."),
-    };
-    let mut builder = tempfile::Builder::new();
-    builder.prefix(".blmesh-");
-    // A temporary is private (0600); the output should get the mode any new file gets (0666
-    // less the umask).
-    #[cfg(unix)]
-    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
-    let mut tmp = builder.tempfile_in(dir)?;
+    let mut tmp = temporary_builder(0o666).tempfile_in(parent_dir(path))?;
     fill(&mut tmp)?;
     tmp.as_file().sync_all()?;
     tmp.persist(path).map_err(|e| e.error)?;
@@ -292,6 +346,21 @@ mod tests {
         assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 0);
         write_atomic(&path, |w| w.write_all(b"whole")).unwrap();
         assert_eq!(std::fs::read(&path).unwrap(), b"whole");
+    }
+
+    /// A failed directory write leaves the old directory as it was and no temporary beside it.
+    #[test]
+    fn atomic_directory_write_keeps_the_old_one_on_failure() {
+        let dir = tempfile::tempdir().unwrap();
+        let path = dir.path().join("out");
+        write_dir_atomic(&path, |d| std::fs::write(d.join("a"), "old")).unwrap();
+        let r = write_dir_atomic(&path, |d| {
+            std::fs::write(d.join("a"), "new")?;
+            Err(std::io::Error::other("boom"))
+        });
+        assert!(r.is_err());
+        assert_eq!(std::fs::read_to_string(path.join("a")).unwrap(), "old");
+        assert_eq!(std::fs::read_dir(dir.path()).unwrap().count(), 1);
     }
 
     #[test]
