@@ -158,17 +158,25 @@ fn thin_gaps_stop_at_the_medial_surface() {
     assert!(l.full_coverage >= 0.85, "full stacks (or gap-limited) at {:.3} of the wall", l.full_coverage);
 }
 
-/// The cut cube, fandisk, the flange and the arrow with 10 layers from 1e-3 of the diagonal:
-/// concave ridges that meet saddles, thin wall triangles along them, a 1 mm bore, fins on a body
-/// with blunt edges. Full stacks (or limited by a thin gap) within two thicknesses of a concave
-/// ridge, without transition layers, and valid meshes. What the flange misses is its bores'
-/// mouths and two saddle corners where its ribs meet the base.
+/// The cut cube, fandisk, the flange and the arrow with issue 7's spec (10 layers from 1e-3 of
+/// the diagonal): concave ridges that meet saddles, thin wall triangles along them, a 1 mm
+/// bore, fins on a body with blunt edges. Full stacks (or limited by a thin gap) within two
+/// thicknesses of a concave ridge, without transition layers: the cut cube 100% (its 4 such
+/// vertices), fandisk 100%, flange 99.1%, arrow 99.4% here (flange 98.9% before the bore's
+/// mouth counted as closing on its axis; arrow 98.1% before a fan whose columns merged into
+/// several bisector columns could stop alone; 95.9% before a column's top could tip sideways
+/// to mend a cell, fandisk 99.3%; 88.3% before columns born between two ridge corners moved at
+/// the ridge's scale, not the corners'; fandisk 95.9% and flange 93.7% before a thin
+/// triangle's late corner could merge early, or stop alone, to mend its cell; flange 97.3% and
+/// arrow 80.1% before faces left flat along a ridge by the merges were collapsed; flange 98.2%
+/// before stacks closing on the bore's axis counted as gap-limited; with the CLI's defaults,
+/// transition layers on, the flange has 99.2%); valid meshes.
 #[test]
 fn cutcube_fandisk_flange_and_arrow_keep_their_layers_at_the_concave_ridges() {
     let cases = [
         ("cutcube_cfmesh.stl", 1.0, 1.0),
         ("fandisk.obj", 0.995, 0.998),
-        ("flange.stl", 0.98, 0.985),
+        ("flange.stl", 0.985, 0.985),
         ("arrow_cape.stl", 0.99, 0.995),
     ];
     for (name, near_concave, full) in cases {

@@ -3,9 +3,8 @@
 //! follows the first-arrival offset (the entropy solution of the eikonal equation) and keeps
 //! marching.
 //!
-//! Every column merges where its characteristic meets a shock computed before the march
-//! ([`super::shock`]): into a neighbour that goes on ([`merge_at_shocks`]), before the cells are
-//! tested. Concave ridges and corners, valleys, steps and fins meeting a body are one rule.
+//! A face column beside a concave ridge merges into the ridge's bisector column as soon as its
+//! proposed top passes the bisector ([`merge_bisector_crossings`]), before the cells are tested.
 //! Then, a front face whose cell would still be invalid while its columns converge (its proposed
 //! top keeps less area than its bottom) loses its most shrunk edge instead of stopping. The
 //! survivor is the column that already lies on the bisector: the one with the larger extrusion
@@ -19,10 +18,14 @@
 //! in front of it). Such a face loses that corner instead, merged into the nearer end of the
 //! edge.
 //!
-//! Last, before a cell's columns stop, a merge along one of its edges that leaves every cell
-//! around valid mends it ([`merge_to_mend`]).
+//! Fronts also meet with no ridge between them (a step lower than the layers are thick, a fin's
+//! edge at a body, a concave valley): a column whose top falls behind its layer's distance from
+//! the wall (a BVH over the walls with layers) merges into a neighbour on time
+//! ([`merge_overtaken`]). Last, before a cell's columns stop, a merge along one of its edges
+//! that leaves every cell around valid mends it ([`merge_to_mend`]).
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
@@ -137,59 +140,156 @@ impl<'a> VertexWalls<'a> {
         triangles.iter().map(|&t| self.normals[t as usize])
     }
 
-    /// Whether a wall with layers that is not around wall vertex `v` lies nearer to `p` than
-    /// `radius`.
-    pub fn foreign_nearer(&self, p: DVec3, v: u32, radius: f64) -> bool {
-        self.layered.any_nearer(p, radius, |corners| corners.contains(&v))
-    }
-
     /// Distance from `p` to the nearest wall with layers (infinite when there is none).
     pub fn distance(&self, p: DVec3) -> f64 {
         self.layered.closest(p).map_or(f64::INFINITY, |w| w.distance)
     }
 }
 
-/// Merge every root column whose layer `k` takes it past its planned shock
-/// ([`super::shock::Shocks`]) into a neighbour root that goes on (not past its own shock this
-/// layer), which keeps its top: the nearest such top, so the merged front moves least. The
-/// earliest shocks go first. The merge is kept unless it leaves more invalid cells around than
-/// there were; a column no neighbour can take is left to the cells' repairs (fronts meeting
-/// head on across a gap: every neighbour is at its shock too).
-pub(super) fn merge_at_shocks(
+/// Merge every face column whose proposed top passes the bisector of a concave ridge column next to
+/// it into that column, before any cell is tested. This is the entropy collapse where it is due,
+/// whatever the shape of the cells: a face column of wall 1 beside a concave ridge has crossed the
+/// bisector once its top is nearer the other wall's offset than its own, i.e. past the plane
+/// through the ridge column's top normal to `n - (n . d) d` (`n` its direction, `d` the ridge
+/// column's). The cells' tests see such a crossing late or not at all where the wall's edges run
+/// obliquely to the ridge, and merge the wrong edge then (two face columns with each other, off the
+/// bisector).
+pub(super) fn merge_bisector_crossings(
     plan: &mut SlabPlan,
     front: &Front,
     columns: &Columns,
-    shocks: &super::shock::Shocks,
-    k: u32,
+    points: &[DVec3],
+    walls: &VertexWalls,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
-) -> usize {
-    let is_root = |plan: &SlabPlan, c: u32| plan.moving[c as usize] && !plan.merges.is_merged(c);
-    let passing = |c: u32| shocks.passed(columns, c as usize, k);
-    let mut due: Vec<(f64, u32)> = (0..columns.len() as u32)
-        .filter(|&c| is_root(plan, c) && passing(c))
-        .map(|c| (shocks.at[c as usize], c))
-        .collect();
-    due.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-    let mut merged = 0;
-    for (_, c) in due {
-        if !is_root(plan, c) {
-            continue;
-        }
-        let apart = |r: u32| plan.proposed[r as usize].distance_squared(plan.proposed[c as usize]);
-        let mut going_on: Vec<(f64, u32)> = neighbour_roots(plan, front, c)
-            .into_iter()
-            .filter(|&r| is_root(plan, r) && !passing(r) && can_merge(plan, front, columns, r, c))
-            .map(|r| (apart(r), r))
-            .collect();
-        going_on.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
-        let took = going_on.into_iter().any(|(_, r)| {
+) {
+    loop {
+        let mut merged = false;
+        for c in 0..columns.len() as u32 {
+            if !plan.moving[c as usize] || plan.merges.is_merged(c) {
+                continue;
+            }
+            // The nearest bisector it has passed (one ridge column beside another may see the
+            // same crossing: the nearer keeps the front's cells in shape).
+            let top = |x: u32| plan.proposed[x as usize];
+            // Equally near (a face column half way between two ridge columns), the one that
+            // leaves no face flat ([`flattened_if_merged`]).
+            let key = |x: u32| {
+                (flattened_if_merged(plan, front, columns, points, x, c), top(x).distance_squared(top(c)))
+            };
+            let Some(r) = passed_bisectors(plan, front, columns, points, walls, c, ANTICIPATION)
+                .into_iter()
+                .map(|x| (key(x), x))
+                .min_by(|(kx, _), (ky, _)| kx.0.cmp(&ky.0).then(kx.1.total_cmp(&ky.1)))
+                .map(|(_, x)| x)
+            else {
+                continue;
+            };
+            if !can_merge(plan, front, columns, r, c) {
+                continue;
+            }
+            // Not into more invalid cells than it leaves (the crossing may have turned some over
+            // already: the cells' repairs mend those).
             let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
             let before = invalid_cells(plan, &group);
-            try_merge_as(plan, columns, (r, c, false), &|plan, group| invalid_cells(plan, group) <= before)
-        });
-        merged += usize::from(took);
+            merged |= try_collapse(plan, columns, r, c, &|plan, group| invalid_cells(plan, group) <= before);
+        }
+        if !merged {
+            break;
+        }
     }
-    merged
+}
+
+/// A column has been overtaken by another wall's front once its proposed top lags its layer's
+/// distance from the wall by more than this many of its layer's heights, counting
+/// [`ANTICIPATION`] times what it fell behind in this layer.
+const OVERTAKEN: f64 = 0.1;
+
+/// A column falling behind by less than this many layer heights in one layer is not being
+/// overtaken: a split column (a chord across a convex front) lags the offset by as much at its
+/// bottom as at its top, and so do faceting errors. (The lag of a column passing a 90-degree
+/// ridge's bisector grows by about one height per layer; with no floor on it every column
+/// counts as late: fandisk's coverage near concave ridges fell to 50%.)
+const FALLING_BEHIND: f64 = 0.25;
+
+/// How late root `c`'s proposed top (its `k`-th layer) is on the first-arrival offset: its lag
+/// behind the layer's distance from the wall, in layer heights, plus [`ANTICIPATION`] times
+/// what it fell behind since its bottom; 0 for a column not falling behind
+/// ([`FALLING_BEHIND`]) or past its stack.
+fn lateness(
+    plan: &SlabPlan,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    c: u32,
+    k: u32,
+) -> f64 {
+    let (Some(d), Some(d_below)) = (columns.distance(c as usize, k), columns.distance(c as usize, k - 1))
+    else {
+        return 0.0;
+    };
+    let h = d - d_below;
+    let top = (d - walls.distance(plan.proposed[c as usize])) / h;
+    let bottom = (d_below - walls.distance(points[columns.node[c as usize] as usize])) / h;
+    if h > 0.0 && top - bottom > FALLING_BEHIND {
+        top + ANTICIPATION * (top - bottom)
+    } else {
+        0.0
+    }
+}
+
+/// Merge every column that another wall's front has overtaken ([`OVERTAKEN`]) into a neighbour
+/// root that is on time (the least late that the cells allow), which keeps its top: the
+/// first-arrival rule itself, wherever fronts meet, with or without a feature ridge between
+/// them (a step narrower than the layers are thick, a fin's edge at a body, a concave valley).
+/// The latest go first. A column whose neighbours are all late (fronts meeting head on across
+/// a gap) is left to the crossing guard, which ends the stacks at the medial surface.
+pub(super) fn merge_overtaken(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    walls: &VertexWalls,
+    k: u32,
+    invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
+) {
+    let is_root = |plan: &SlabPlan, c: u32| plan.moving[c as usize] && !plan.merges.is_merged(c);
+    // The merges here keep the survivors' tops, so every column's lateness holds all along.
+    let late: Vec<f64> = (0..columns.len() as u32)
+        .into_par_iter()
+        .map(|c| if plan.moving[c as usize] { lateness(plan, columns, points, walls, c, k) } else { 0.0 })
+        .collect();
+    loop {
+        let mut overtaken: Vec<(f64, u32)> = (0..columns.len() as u32)
+            .filter(|&c| is_root(plan, c) && late[c as usize] > OVERTAKEN)
+            .map(|c| (late[c as usize], c))
+            .collect();
+        overtaken.sort_by(|x, y| y.0.total_cmp(&x.0));
+        let mut merged = false;
+        for (_, c) in overtaken {
+            if !is_root(plan, c) {
+                continue;
+            }
+            // Equally late, the nearest top: merging moves the front least.
+            let apart = |r: u32| plan.proposed[r as usize].distance_squared(plan.proposed[c as usize]);
+            let mut on_time: Vec<(f64, f64, u32)> = neighbour_roots(plan, front, c)
+                .into_iter()
+                .filter(|&r| is_root(plan, r) && can_merge(plan, front, columns, r, c))
+                .map(|r| (late[r as usize], apart(r), r))
+                .filter(|&(l, _, _)| l <= OVERTAKEN)
+                .collect();
+            on_time.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
+            merged |= on_time.into_iter().any(|(_, _, r)| {
+                let group: Vec<u32> = plan.merges.group(r).chain(plan.merges.group(c)).collect();
+                let before = invalid_cells(plan, &group);
+                try_merge_as(plan, columns, (r, c, false), &|plan, group| {
+                    invalid_cells(plan, group) <= before
+                })
+            });
+        }
+        if !merged {
+            break;
+        }
+    }
 }
 
 /// A flat top whose longest edge keeps at least this fraction of its bottom's is flat along a
@@ -200,7 +300,8 @@ const LINE_LIKE: f64 = 0.5;
 /// a line ([`LINE_LIKE`]), with three corners or more still apart, if the cells around allow
 /// it. The merges make such faces: where the face columns beside a ridge merge into its ridge
 /// columns, one that goes back along the ridge next to one that goes forward leaves the face
-/// between them flat along the bisector, over three ridge columns; the other wall's front meets the ridge's middle
+/// between them flat along the bisector, over three ridge columns ([`flattened_if_merged`]
+/// avoids it only where a choice is left); the other wall's front meets the ridge's middle
 /// column, the flat face does not, and the two cross. Merging the middle ridge column with one
 /// beside it (equal columns meet in the middle, on the bisector of a straight ridge) gives both
 /// sides the same edge there. So do a wall edge far shorter than the layer (its face turns
@@ -274,6 +375,32 @@ pub(super) fn neighbour_roots(plan: &SlabPlan, front: &Front, c: u32) -> Vec<u32
 /// still apart, is flat.
 const FLAT_TOP: f64 = 0.05;
 
+/// How many faces around root `c`'s group would be left flat ([`FLAT_TOP`]) with three distinct
+/// corners if `c` merged into root `r`: two face columns beside a ridge merged into two ridge
+/// columns with a third between them fold the front along the ridge, every cell valid.
+fn flattened_if_merged(
+    plan: &SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    points: &[DVec3],
+    r: u32,
+    c: u32,
+) -> usize {
+    let group: Vec<u32> = plan.merges.group(c).collect();
+    let root = |x: u32| if plan.merges.root(x) == c { r } else { plan.merges.root(x) };
+    front
+        .faces_around_columns(&group)
+        .into_iter()
+        .filter(|&f| {
+            let mut roots: Vec<u32> = front.face_columns(f).iter().map(|&x| root(x)).collect();
+            roots.sort_unstable();
+            roots.dedup();
+            roots.len() >= 3
+                && area_ratio_with(plan, front, f, columns, points, root).is_some_and(|a| a < FLAT_TOP)
+        })
+        .count()
+}
+
 /// The concave ridge columns (roots) beside root `c`'s group whose bisectors `c` has passed, or
 /// will within `anticipation` of its last approach ([`crosses_bisector`]).
 fn passed_bisectors(
@@ -294,9 +421,7 @@ fn passed_bisectors(
 }
 
 /// Whether column `c`'s proposed top has passed the bisector through concave ridge column `r`
-/// that its bottom is short of: its top is nearer the other wall's offset than its own, i.e.
-/// past the plane through the ridge column's top normal to `n - (n . d) d` (`n` its direction,
-/// `d` the ridge column's).
+/// that its bottom is short of (see [`merge_bisector_crossings`]).
 fn crosses_bisector(
     plan: &SlabPlan,
     columns: &Columns,
@@ -387,6 +512,9 @@ const SAME_WALL_COSINE: f64 = 0.9;
 /// Directions closer than this (the length of `n - (n . d) d`, the sine of their angle) leave
 /// the bisector test undecided.
 const MIN_BISECTOR_SINE: f64 = 0.2;
+
+/// How many of its last approaches to a bisector ahead a column is merged.
+const ANTICIPATION: f64 = 1.0;
 
 /// Collapse the corner of invalid triangle `f` that closes in fastest on its opposite edge into
 /// the nearer end of that edge, if the front allows it; returns the surviving root. This is a
@@ -672,7 +800,7 @@ mod tests {
     /// and wall 2 (x = 0, y > 0, normal +x): column 0 on the ridge, column 1 at `at` on the
     /// wall with direction `dir`, both `d` out (the ridge column by its scale, on the bisector).
     fn ridge_case(at: DVec3, dir: DVec3, d: f64) -> bool {
-        ridge_case_ahead(at, dir, d, 1.0)
+        ridge_case_ahead(at, dir, d, ANTICIPATION)
     }
 
     fn ridge_case_ahead(at: DVec3, dir: DVec3, d: f64, anticipation: f64) -> bool {
@@ -714,6 +842,64 @@ mod tests {
         // To mend a cell, a column two approaches short of the bisector merges, not three.
         assert!(ridge_case_ahead(at, DVec3::Y, 0.04, REPAIR_ANTICIPATION));
         assert!(!ridge_case_ahead(at, DVec3::Y, 0.02, REPAIR_ANTICIPATION));
+    }
+
+    /// Lateness (in layer heights) of a column from `bottom` to `top` at its layer `k` of
+    /// uniform 0.1-high layers, over [`two_walls`] extended far out.
+    fn lateness_case(bottom: DVec3, top: DVec3, k: u32) -> f64 {
+        let spec = crate::config::LayerSpec::fixed(0.1, 1.0, 20);
+        let mut columns = Columns::default();
+        columns.push(ColumnStart {
+            base: bottom,
+            dir: (top - bottom).normalize(),
+            scale: 1.0,
+            node: 0,
+            layers: k - 1,
+            wall_vertex: 0,
+            slide: Default::default(),
+            spec: Some(spec),
+            last_step: 0.1,
+        });
+        let plan = SlabPlan::moving_to(vec![top]);
+        let surface = two_walls(10.0);
+        let topology = Topology::new(&surface);
+        let walls = VertexWalls::new(&surface, &topology, |_| true);
+        lateness(&plan, &columns, &[bottom], &walls, 0, k)
+    }
+
+    #[test]
+    fn a_column_passing_the_other_walls_offset_is_late_and_a_chord_is_not() {
+        // On wall 1 (y = 0) 0.25 from wall 2 (x = 0), moving up +y: layer 2 (0.1 to 0.2) is on
+        // time, layer 3 (0.2 to 0.3) ends 0.05 nearer wall 2 than its distance, and fell behind
+        // by as much: half a layer late, plus half anticipated.
+        let at = |d: f64| DVec3::new(0.25, d, 1.0);
+        assert_eq!(lateness_case(at(0.1), at(0.2), 2), 0.0);
+        assert!((lateness_case(at(0.2), at(0.3), 3) - 1.0).abs() < 1e-9);
+        // Late by as much at its bottom as at its top (a split column's chord): not overtaken.
+        let chord = |d: f64| DVec3::new(2.0, d - 0.05, 1.0);
+        assert_eq!(lateness_case(chord(0.2), chord(0.3), 3), 0.0);
+    }
+
+    /// Ridge columns 0, 1, 2 along x at y = 0 and face columns 3 (x = 0.5) and 4 (x = 1.5) at
+    /// y = 1, in triangles (0, 1, 3), (3, 1, 4), (1, 2, 4); every top 0.1 up the ridge's
+    /// bisector, so the ridge columns' tops lie on a line. Column 3 has merged into 0.
+    #[test]
+    fn a_merge_that_would_fold_the_front_along_a_ridge_is_seen() {
+        let bottoms =
+            [(0.0, 0.0), (1.0, 0.0), (2.0, 0.0), (0.5, 1.0), (1.5, 1.0)].map(|(x, y)| DVec3::new(x, y, 0.0));
+        let columns = Columns::rising(&bottoms, None);
+        let mut front = Front::default();
+        for t in [[0, 1, 3], [3, 1, 4], [1, 2, 4]] {
+            front.push(&t, 0, None);
+        }
+        front.index_columns(5);
+        let up = DVec3::new(0.0, 0.1, 0.1);
+        let mut plan = SlabPlan::moving_to(bottoms.iter().map(|&b| DVec3::new(b.x, 0.0, 0.0) + up).collect());
+        plan.merges.merge(0, 3);
+        // Into 2: triangle (3, 1, 4) becomes (0, 1, 2), three tops on a line.
+        assert_eq!(flattened_if_merged(&plan, &front, &columns, &bottoms, 2, 4), 1);
+        // Into 1: it keeps two corners and vanishes, and so does (1, 2, 4): nothing left flat.
+        assert_eq!(flattened_if_merged(&plan, &front, &columns, &bottoms, 1, 4), 0);
     }
 
     /// A ridge along x (columns 0-4 at y = 0) between two walls of face columns (5-8 at y = 1,

@@ -16,7 +16,6 @@ use super::collapse::Merges;
 use super::entropy::VertexWalls;
 use super::front::{Columns, Front, NOT_MERGED};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
-use super::shock::Shocks;
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
 use super::split::{self, Adapt, Sizes, Splits, NONE};
 use super::swap::{self, SwapRole, Swaps};
@@ -46,9 +45,6 @@ pub struct MarchStats {
     pub splits: usize,
     /// Short front edges collapsed to the tangential size (two columns merged into one).
     pub tangential_collapses: usize,
-    /// Of the collapses where fronts met, the columns merged at their planned shocks
-    /// ([`super::shock`]).
-    pub shock_merges: usize,
     /// Of the collapses where fronts met, those of faces left flat along a line.
     pub flat_top_collapses: usize,
     /// Columns turned towards their neighbours' direction to mend an invalid cell, instead of
@@ -160,8 +156,6 @@ pub(super) struct SlabPlan {
     pub collapses: usize,
     /// Of those, the tangential collapses of short edges ([`super::coarsen`]).
     pub coarsened: usize,
-    /// Of those, the merges of columns at their planned shocks ([`entropy::merge_at_shocks`]).
-    pub at_shocks: usize,
     /// Of those, the collapses of faces left flat along a line ([`entropy::merge_flat_tops`]).
     pub flat_tops: usize,
     /// Columns bent to mend an invalid cell ([`bend::bend_to_mend`]).
@@ -183,7 +177,6 @@ impl SlabPlan {
             redirected: Vec::new(),
             collapses: 0,
             coarsened: 0,
-            at_shocks: 0,
             flat_tops: 0,
             bends: 0,
             tips: 0,
@@ -427,7 +420,6 @@ pub fn march(
     let mut stats = MarchStats::default();
     let mut guard = CrossingGuard::default();
     let mut pit: Vec<Option<f64>> = vec![None; columns.len()];
-    let mut shocks = Shocks::default();
     for k in 1..=max_layers {
         let _layer = tracing::debug_span!("layer", k).entered();
         for c in 0..columns.len() {
@@ -464,14 +456,11 @@ pub fn march(
             }
         };
         proposed.extend_from_slice(&reshape.splits.top);
-        shocks.extend(columns, walls);
-        let plan =
-            settle_slab(mesh, columns, front, proposed, &mut reshape, sizes, walls, &shocks, &mut guard, k);
+        let plan = settle_slab(mesh, columns, front, proposed, &mut reshape, sizes, walls, &mut guard, k);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
         stats.collapses += plan.collapses - plan.coarsened;
         stats.tangential_collapses += plan.coarsened;
-        stats.shock_merges += plan.at_shocks;
         stats.flat_top_collapses += plan.flat_tops;
         stats.bent_columns += plan.bends;
         stats.tipped_columns += plan.tips;
@@ -660,8 +649,8 @@ fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach
 
 /// Decide which columns move and merge so that every cell of the slab is valid and the new
 /// front does not cross itself: first the tangential collapses of short edges (unless
-/// adaptivity is off), then the merges of columns at their planned shocks
-/// ([`entropy::merge_at_shocks`]), then the repairs of invalid cells and of crossings.
+/// adaptivity is off), then the merges of face columns passing a concave ridge's bisector
+/// ([`entropy::merge_bisector_crossings`]), then the repairs of invalid cells and of crossings.
 #[allow(clippy::too_many_arguments)]
 fn settle_slab(
     mesh: &VolumeMesh,
@@ -671,7 +660,6 @@ fn settle_slab(
     reshape: &mut Reshape,
     sizes: &Sizes,
     walls: &VertexWalls,
-    shocks: &Shocks,
     guard: &mut CrossingGuard,
     k: u32,
 ) -> SlabPlan {
@@ -689,7 +677,8 @@ fn settle_slab(
             plan.coarsened = coarsening.made;
             plan.crushed_stops = stop_crushed_transition(&mut plan, columns, &coarsening.crushed);
         }
-        plan.at_shocks = entropy::merge_at_shocks(&mut plan, front, columns, shocks, k, invalid_cells);
+        entropy::merge_bisector_crossings(&mut plan, front, columns, &mesh.points, walls, invalid_cells);
+        entropy::merge_overtaken(&mut plan, front, columns, &mesh.points, walls, k, invalid_cells);
         plan.flat_tops = entropy::merge_flat_tops(&mut plan, front, columns, &mesh.points, k, invalid_cells);
     }
     let mut to_check: Vec<usize> = (0..front.len()).collect();

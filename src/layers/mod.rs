@@ -12,7 +12,6 @@ pub mod front;
 pub mod gap;
 pub mod guard;
 pub mod march;
-pub mod shock;
 pub mod slab;
 pub mod sliding;
 pub mod smoothness;

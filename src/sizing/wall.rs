@@ -42,32 +42,6 @@ impl WallDistance {
         })
     }
 
-    /// Whether a wall triangle that `skip` does not rule out (given its vertex ids) lies nearer
-    /// to `p` than `radius`.
-    pub fn any_nearer(&self, p: DVec3, radius: f64, skip: impl Fn([u32; 3]) -> bool) -> bool {
-        if radius <= 0.0 {
-            return false;
-        }
-        let limit = radius * radius;
-        // Once one is found the best cost drops to -1 and every subtree is cut off.
-        let found = std::cell::Cell::new(false);
-        self.bvh.branch_and_bound(
-            |bounds| box_distance_squared(p, bounds),
-            |t, [a, b, c]| {
-                if !found.get() && !skip(self.triangles[t as usize]) {
-                    let q = closest_point_on_triangle(p, *a, *b, *c);
-                    found.set((q - p).length_squared() < limit);
-                }
-                if found.get() {
-                    -1.0
-                } else {
-                    limit
-                }
-            },
-        );
-        found.get()
-    }
-
     /// Unit direction from the wall point `near` to `p` (the distance gradient); the triangle's
     /// normal when `p` is on the wall.
     pub fn direction_from(&self, near: &WallPoint, p: DVec3) -> DVec3 {
