@@ -52,3 +52,54 @@ fn a_seed_gives_the_same_body_every_time_and_fineness_only_refines() {
         assert_ne!(family_body(family, 8).points, a.points, "{}", family.name());
     }
 }
+
+#[path = "common/family_run.rs"]
+mod family_run;
+
+use family_run::{describe, run_seed, table, SeedResult, Spread};
+
+/// The CI spread: three seeds of each family (21 bodies) at a moderate tessellation.
+const PIPELINE_SEEDS: u64 = 3;
+/// Wall edges per length relative to the families' own: coarser, to keep the run short.
+const CI_FINENESS: f64 = 0.7;
+
+fn pipeline_results() -> Vec<SeedResult> {
+    let start = Instant::now();
+    let mut results = Vec::new();
+    for family in Family::ALL {
+        for seed in 0..PIPELINE_SEEDS {
+            let r = run_seed(family, seed, CI_FINENESS);
+            eprintln!("{}", describe(&r));
+            results.push(r);
+        }
+    }
+    eprintln!("{}\n{} bodies in {:.1} s", table(&results), results.len(), start.elapsed().as_secs_f64());
+    results
+}
+
+#[test]
+fn family_meshes_pass_the_checker_on_every_seed() {
+    let results = pipeline_results();
+    for r in &results {
+        let m = r.measures.as_ref().unwrap_or_else(|e| panic!("{} seed {}: {e}", r.family, r.seed));
+        assert!(m.valid && m.conforming && m.volume_identity, "{}", describe(r));
+    }
+}
+
+/// The bars the layer march is to reach on unseen bodies: near-concave coverage median at
+/// least 99.5% and 5th percentile at least 98%, no core tetrahedron below 10 deg on any seed.
+#[test]
+#[ignore = "a target the march does not reach yet: run with --ignored"]
+fn family_near_concave_coverage_and_core_dihedral_reach_the_targets() {
+    let results = pipeline_results();
+    let measured: Vec<_> = results.iter().filter_map(|r| r.measures.as_ref().ok()).collect();
+    assert_eq!(measured.len(), results.len(), "every seed meshes");
+    let coverage: Vec<f64> = measured.iter().map(|m| m.near_concave_coverage).collect();
+    let spread = Spread::of(&coverage, true).expect("some seeds");
+    assert!(spread.median >= 0.995, "near-concave coverage median {:.2}%", 100.0 * spread.median);
+    assert!(spread.p5 >= 0.98, "near-concave coverage 5th percentile {:.2}%", 100.0 * spread.p5);
+    for r in &results {
+        let m = r.measures.as_ref().unwrap();
+        assert!(m.core_min_dihedral >= 10.0, "{}", describe(r));
+    }
+}
