@@ -650,6 +650,9 @@ fn clip_line(centre: [f64; 2], along: [f64; 2], size: [f64; 2]) -> Option<[[f64;
     let (mut side0, mut side1) = ((0, 0.0), (0, 0.0));
     for k in 0..2 {
         if along[k] == 0.0 {
+            if !(0.0..=size[k]).contains(&centre[k]) {
+                return None;
+            }
             continue;
         }
         let (a, b) = ((0.0 - centre[k]) / along[k], (size[k] - centre[k]) / along[k]);
@@ -957,4 +960,53 @@ fn turned_square(centre: [f64; 2], side: f64, angle: f64, h: f64) -> Vec<[f64; 2
             along[..along.len() - 1].iter().map(move |&t| lerp2(corners[k], corners[(k + 1) % 4], t))
         })
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn splitmix64_gives_the_reference_sequence() {
+        // The first output of SplitMix64 from state 0 in the reference implementation.
+        assert_eq!(SplitMix64::new(0).next_u64(), 0xE220_A839_7B1D_CDAF);
+        let mut rng = SplitMix64::new(42);
+        assert!((0..1000).map(|_| rng.unit()).all(|u| (0.0..1.0).contains(&u)));
+    }
+
+    #[test]
+    fn samples_are_the_same_either_way_and_pass_through_the_breaks() {
+        let forward = samples(0.0, 1.3, 0.1, &[0.37, 2.0]);
+        let mut backward = samples(1.3, 0.0, 0.1, &[0.37]);
+        backward.reverse();
+        assert_eq!(forward, backward);
+        assert!(
+            forward.contains(&0.37) && forward.windows(2).all(|w| w[1] > w[0] && w[1] - w[0] <= 0.1 + 1e-12)
+        );
+        assert_eq!((forward[0], *forward.last().unwrap()), (0.0, 1.3));
+    }
+
+    #[test]
+    fn a_clipped_line_ends_exactly_on_the_sides() {
+        let [a, b] = clip_line([0.5, 0.5], [0.3f64.sin(), 0.3f64.cos()], [1.0, 2.0]).unwrap();
+        assert_eq!((a[1], b[1]), (0.0, 2.0), "through the south and north sides");
+        let ends = crease_breaks([1.0, 2.0], &[[a, b]]);
+        assert_eq!((ends[0].len(), ends[2].len()), (1, 1));
+        assert!(clip_line([5.0, 0.5], [0.0, 1.0], [1.0, 2.0]).is_none());
+    }
+
+    #[test]
+    fn a_naca_section_is_closed_counter_clockwise_and_as_thick_as_asked() {
+        let section = naca_section(0.12, 40);
+        let area: f64 = (0..section.len())
+            .map(|k| {
+                let (a, b) = (section[k], section[(k + 1) % section.len()]);
+                0.5 * (a[0] * b[1] - b[0] * a[1])
+            })
+            .sum();
+        assert!(area > 0.0, "counter-clockwise");
+        let thickest = section.iter().map(|p| p[1]).fold(0.0, f64::max);
+        assert!((2.0 * thickest - 0.12).abs() < 0.002, "{thickest}");
+        assert_eq!(section[0], [1.0, 0.0]);
+    }
 }
