@@ -33,7 +33,7 @@ pub const SPEC_STACK_FRACTION: f64 = 1e-3 * 25.958_682_112;
 pub enum Family {
     /// A wing (NACA 00xx section, sweep, lean, taper, tip cap) standing on a plate.
     WingPlate,
-    /// A fin standing on the curved side of a cylinder with flat ends (a fuselage).
+    /// A fin standing on the curved side of a cylinder with flat or rounded ends (a fuselage).
     FinCylinder,
     /// A cylinder or a turned box standing on a plate (concave and saddle corners).
     PostPlate,
@@ -776,7 +776,7 @@ impl Builder {
     }
 
     /// The cylinder `map` draws over `[0, length] x [-pi r, pi r]`, with `hole` in its side and
-    /// flat ends.
+    /// flat or rounded ends.
     fn cylinder(&mut self, radius: f64, length: f64, hole: Vec<Node>, map: impl Fn([f64; 2]) -> DVec3) {
         let h = self.spacing;
         let half = PI * radius;
@@ -788,14 +788,19 @@ impl Builder {
         let region = Region { loops: vec![join_sides(&side_nodes), hole], ..Default::default() };
         let face = self.face(&region, h, &map);
         self.pieces.add(face, "wall", false);
-        for (end, x) in [(3, 0.0), (1, length)] {
+        for (end, x, outward) in [(3, 0.0, -1.0), (1, length, 1.0)] {
+            // Half the ends are flat, half rounded: half an ellipsoid 0.5-1.5 radii long.
+            let nose = if self.rng.chance(0.5) { self.rng.range(0.5, 1.5) * radius } else { 0.0 };
             let ring: &Vec<Node> = &side_nodes[end];
             let ring =
                 ring[..ring.len() - 1].iter().map(|n| Node { uv: [n.at.y, n.at.z], at: n.at }).collect();
-            let face = self
-                .face(&Region { loops: vec![ring], ..Default::default() }, h, |[y, z]| DVec3::new(x, y, z));
-            // The (y, z) plane faces +x: the end at x = 0 is reversed.
-            self.pieces.add(face, "wall", x == 0.0);
+            let face = self.face(&Region { loops: vec![ring], ..Default::default() }, h, |[y, z]| {
+                let rise = (1.0 - (y * y + z * z) / (radius * radius)).max(0.0).sqrt();
+                DVec3::new(x + outward * nose * rise, y, z)
+            });
+            // The (y, z) plane faces +x: the end at x = 0 is reversed (a rounded end is a graph
+            // over it, so it turns alike).
+            self.pieces.add(face, "wall", outward < 0.0);
         }
     }
 
