@@ -83,6 +83,8 @@ pub fn family_body(family: Family, seed: u64) -> Surface {
 /// The body of `family` for `seed` with `fineness` times as many wall edges per length (the
 /// shape and the other random choices do not depend on it).
 pub fn family_body_at(family: Family, seed: u64, fineness: f64) -> Surface {
+    // The family mixed into the seed (times PCG's 64-bit multiplier), so that the same seed
+    // draws different numbers for different families.
     let mut rng = SplitMix64::new(seed ^ (family as u64).wrapping_mul(0x5851_F42D_4C95_7F2D));
     let spacing = WALL_SPACING[0] * (WALL_SPACING[1] / WALL_SPACING[0]).powf(rng.unit()) / fineness;
     let mut b = Builder { rng, spacing, fineness, pieces: Pieces::default() };
