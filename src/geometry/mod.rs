@@ -1,6 +1,7 @@
 //! Geometric vocabulary: the point type and the exact predicates every topological decision uses.
 
 pub mod bvh;
+pub mod cdt;
 pub mod distance;
 pub mod grid;
 pub mod intersect;

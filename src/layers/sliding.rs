@@ -284,7 +284,7 @@ pub fn triangulate_region(
         handle_node.insert(h.index(), points.len() as u32);
         points.push(plane.project(plane.origin + u * x.x + v * x.y));
     }
-    let inside = inside_faces(&cdt);
+    let inside = crate::geometry::cdt::inside_faces(&cdt, |e| cdt.is_constraint_edge(e));
     let mut triangles = Vec::new();
     for face in cdt.inner_faces() {
         if !inside[face.fix().index()] {
@@ -328,37 +328,6 @@ fn clear_of(x: DVec3, boundary: &[(u32, u32)], points: &[DVec3]) -> bool {
         let t = ((x - a).dot(b - a) / (length * length)).clamp(0.0, 1.0);
         (a + (b - a) * t - x).length() >= CLEARANCE * length
     })
-}
-
-/// Faces of the triangulation inside the constraint edges (an odd number of them crossed on
-/// the way from the outer face), by face index.
-fn inside_faces(cdt: &ConstrainedDelaunayTriangulation<Point2<f64>>) -> Vec<bool> {
-    let mut parity: Vec<Option<bool>> = vec![None; cdt.num_all_faces()];
-    let outer = cdt.outer_face();
-    parity[outer.fix().index()] = Some(false);
-    let mut stack = vec![(outer.fix(), false)];
-    while let Some((face, inside)) = stack.pop() {
-        // Each edge of the face, with the face across it.
-        let edges: Vec<_> = match cdt.face(face).as_inner() {
-            Some(inner) => inner.adjacent_edges().iter().map(|e| (*e, e.rev().face().fix())).collect(),
-            None => cdt
-                .convex_hull()
-                .map(|e| {
-                    let across = if e.face().is_outer() { e.rev().face() } else { e.face() };
-                    (e, across.fix())
-                })
-                .collect(),
-        };
-        for (e, across) in edges {
-            if parity[across.index()].is_some() {
-                continue;
-            }
-            let flips = cdt.is_constraint_edge(e.as_undirected().fix());
-            parity[across.index()] = Some(inside != flips);
-            stack.push((across, inside != flips));
-        }
-    }
-    parity.into_iter().map(|p| p.unwrap_or(false)).collect()
 }
 
 /// The new triangles must face like the plane and use every boundary edge once.

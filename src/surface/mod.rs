@@ -213,4 +213,5 @@ mod tests {
     }
 }
 
+pub mod family;
 pub mod shapes;
