@@ -126,8 +126,6 @@ fn v_grooves_of_60_90_120_degrees_keep_every_layer() {
 
 /// The same four surfaces hold nothing a finite-volume solver would reject.
 #[test]
-#[ignore = "flange.stl: 2 faces with a wrong face pyramid (tetrahedron-tetrahedron and \
-            tetrahedron-pyramid) next to a nearly flat cell of volume 1e-25"]
 fn cutcube_fandisk_flange_and_arrow_are_accepted_by_a_finite_volume_solver() {
     let names = ["cutcube_cfmesh.stl", "fandisk.obj", "flange.stl", "arrow_cape.stl"];
     let rejected: Vec<String> = names

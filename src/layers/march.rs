@@ -23,7 +23,7 @@ use super::{bend, coarsen, entropy};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::normals::constraint::Slide;
-use crate::quality::measures::CellPoints;
+use crate::quality::measures::{is_float_flat, CellPoints};
 use crate::quality::validity::cell_validity;
 
 /// Zone of the layer cells in the output mesh.
@@ -101,7 +101,7 @@ impl<'a> Proposal<'a> {
         match cell {
             SlabCell::Empty => true,
             SlabCell::Flat => false,
-            SlabCell::Standard { kind, nodes } => cell_validity(*kind, &self.gather(nodes)).is_valid(),
+            SlabCell::Standard { kind, nodes } => solid(*kind, &self.gather(nodes)),
             SlabCell::Split { faces, apex } => {
                 let apex_point = match apex {
                     Some(a) => self.position(*a),
@@ -111,7 +111,7 @@ impl<'a> Proposal<'a> {
                     let last = nodes.len() - 1;
                     let mut x = self.gather(&nodes[..last]);
                     x[last] = apex_point;
-                    cell_validity(kind, &x).is_valid()
+                    solid(kind, &x)
                 })
             }
         }
@@ -124,6 +124,12 @@ impl<'a> Proposal<'a> {
         nodes.dedup();
         nodes.iter().map(|&n| self.position(n)).sum::<DVec3>() / nodes.len() as f64
     }
+}
+
+/// Whether a layer cell is valid by the exact tests and not flat in floating point, where a
+/// finite-volume solver would see its face pyramids turn over.
+fn solid(kind: CellKind, x: &CellPoints) -> bool {
+    cell_validity(kind, x).is_valid() && !is_float_flat(kind, x)
 }
 
 /// The cells of a split polyhedron: a tetrahedron per triangle face and a pyramid per quad face,

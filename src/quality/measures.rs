@@ -61,6 +61,23 @@ pub fn volume(kind: CellKind, x: &CellPoints) -> f64 {
     v
 }
 
+/// A cell whose smallest decomposition tetrahedron is below this fraction of the cube of its
+/// bounding-box diagonal is flat in floating point: a triple product's round-off is about 1e-16
+/// of that cube, so the signs of the face-pyramid volumes a finite-volume solver computes on it
+/// would be noise, however the exact orientation tests decide.
+pub const FLOAT_FLAT: f64 = 1e-12;
+
+/// Whether a cell that may be valid by exact predicates is flat in floating point
+/// ([`FLOAT_FLAT`]).
+pub fn is_float_flat(kind: CellKind, x: &CellPoints) -> bool {
+    let nodes = &x[..kind.node_count()];
+    let (lo, hi) = nodes.iter().fold((nodes[0], nodes[0]), |(lo, hi), &p| (lo.min(p), hi.max(p)));
+    let floor = FLOAT_FLAT * (hi - lo).length().powi(3);
+    let mut flat = false;
+    for_each_subtet(kind, x, |_, [a, b, c, d]| flat |= tet_signed_volume(a, b, c, d) <= floor);
+    flat
+}
+
 /// The corner edge vectors of corner `[o, a, b, d]`.
 fn corner_edges(x: &CellPoints, [o, a, b, d]: [usize; 4]) -> [DVec3; 3] {
     [x[a] - x[o], x[b] - x[o], x[d] - x[o]]
@@ -133,6 +150,23 @@ pub fn dihedral_range(kind: CellKind, x: &CellPoints, pairs: &[(usize, usize)]) 
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_cell_flatter_than_round_off_is_float_flat_and_a_thin_layer_cell_is_not() {
+        let tet = |apex_height: f64| {
+            let mut x = [DVec3::ZERO; 8];
+            x[..4].copy_from_slice(&[DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::new(0.3, 0.3, apex_height)]);
+            x
+        };
+        assert!(is_float_flat(CellKind::Tetrahedron, &tet(1e-14)));
+        assert!(is_float_flat(CellKind::Tetrahedron, &tet(-1.0)));
+        // A first layer a millionth of its wall edge is still a solid prism.
+        assert!(!is_float_flat(CellKind::Tetrahedron, &tet(1e-6)));
+        let mut prism = [DVec3::ZERO; 8];
+        let h = 1e-6 * DVec3::Z;
+        prism[..6].copy_from_slice(&[DVec3::ZERO, DVec3::X, DVec3::Y, h, DVec3::X + h, DVec3::Y + h]);
+        assert!(!is_float_flat(CellKind::Prism, &prism));
+    }
 
     /// measure.py's self-test cells: unit cube corners plus a pyramid apex.
     fn reference(kind: CellKind) -> (CellPoints, f64, f64) {
