@@ -86,8 +86,9 @@ struct YplusArgs {
 struct MeshArgs {
     /// Input surface (.stl, .obj, .off, .msh, .mesh, .meshb, .tri, .uh3d).
     input: PathBuf,
-    /// Output mesh; the format follows the extension (.msh, .vtu, .su2, .mesh, .meshb, .cgns), or
-    /// an OpenFOAM polyMesh directory when the last component is `polyMesh`.
+    /// Output mesh; the format follows the extension (.msh, .vtu, .su2, .mesh, .meshb, .cgns,
+    /// .ugrid / .b8.ugrid / .lb8.ugrid with a FUN3D .mapbc beside), or an OpenFOAM polyMesh
+    /// directory when the last component is `polyMesh`.
     #[arg(short, long)]
     output: PathBuf,
     /// TOML configuration file (flags override it).

@@ -177,7 +177,8 @@ fn write_boundary(w: &mut dyn Write, mesh: &VolumeMesh, table: &FaceTable, roles
     writeln!(w, ")")
 }
 
-fn role_of(patch: usize, mesh: &VolumeMesh, roles: &[Role]) -> Role {
+/// The role of patch `patch`: `roles[patch]`, else [`super::cgns::default_role`] of its name.
+pub(super) fn role_of(patch: usize, mesh: &VolumeMesh, roles: &[Role]) -> Role {
     match (roles.get(patch), mesh.patch_names.get(patch)) {
         (Some(&role), _) => role,
         (None, Some(name)) => super::cgns::default_role(name),

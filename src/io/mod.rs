@@ -14,6 +14,7 @@ pub mod off;
 mod scan;
 pub mod stl;
 pub mod su2;
+pub mod ugrid;
 pub mod uh3d;
 pub mod vtu;
 
@@ -171,10 +172,15 @@ pub enum MeshFormat {
     Cgns,
     /// OpenFOAM polyMesh directory (ASCII), chosen by the output's last component `polyMesh`.
     Foam,
+    /// AFLR3/FUN3D UGRID (`.ugrid` ASCII, `.b8.ugrid`, `.lb8.ugrid`) with a FUN3D `.mapbc` beside.
+    Ugrid {
+        encoding: ugrid::Encoding,
+    },
 }
 
 /// The volume mesh output extensions, for messages.
-pub const MESH_EXTENSIONS: &str = ".msh, .vtu, .su2, .mesh, .meshb, .cgns, or a directory named polyMesh";
+pub const MESH_EXTENSIONS: &str =
+    ".msh, .vtu, .su2, .mesh, .meshb, .cgns, .ugrid, .b8.ugrid, .lb8.ugrid, or a directory named polyMesh";
 
 impl MeshFormat {
     pub fn from_path(path: &Path, ascii: bool) -> Option<Self> {
@@ -189,6 +195,7 @@ impl MeshFormat {
             "mesh" => Some(MeshFormat::Medit { binary: false }),
             "meshb" => Some(MeshFormat::Medit { binary: true }),
             "cgns" => Some(MeshFormat::Cgns),
+            "ugrid" => ugrid::Encoding::from_path(path).map(|encoding| MeshFormat::Ugrid { encoding }),
             _ => None,
         }
     }
@@ -204,8 +211,8 @@ pub fn write_volume_mesh(path: &Path, mesh: &VolumeMesh, format: MeshFormat) -> 
     write_volume_mesh_with_roles(path, mesh, format, &[])
 }
 
-/// [`write_volume_mesh`] with the role of each patch (CGNS boundary condition types; patches
-/// beyond `roles` get [`cgns::default_role`]).
+/// [`write_volume_mesh`] with the role of each patch (CGNS boundary condition types, polyMesh
+/// patch types, UGRID's `.mapbc` codes; patches beyond `roles` get [`cgns::default_role`]).
 pub fn write_volume_mesh_with_roles(
     path: &Path,
     mesh: &VolumeMesh,
@@ -219,6 +226,7 @@ pub fn write_volume_mesh_with_roles(
         MeshFormat::Medit { binary } => write_atomic(path, |w| medit::write_volume(w, mesh, binary)),
         MeshFormat::Cgns => cgns::write(path, mesh, roles),
         MeshFormat::Foam => foam::write(path, mesh, roles),
+        MeshFormat::Ugrid { encoding } => ugrid::write_files(path, mesh, roles, encoding),
     }
 }
 
@@ -372,6 +380,16 @@ mod tests {
             assert!(why.contains("--features cgns"), "{why}");
         }
         assert_eq!(MeshFormat::Su2.unavailable(), None);
+    }
+
+    #[test]
+    fn ugrid_encoding_comes_from_the_suffix_before_the_extension() {
+        let format = |name: &str| MeshFormat::from_path(Path::new(name), false);
+        let ugrid = |encoding| Some(MeshFormat::Ugrid { encoding });
+        assert_eq!(format("wing.b8.ugrid"), ugrid(ugrid::Encoding::BigEndian));
+        assert_eq!(format("wing.lb8.ugrid"), ugrid(ugrid::Encoding::LittleEndian));
+        assert_eq!(format("wing.ugrid"), ugrid(ugrid::Encoding::Ascii));
+        assert_eq!(format("wing.r8.ugrid"), None);
     }
 
     #[test]

@@ -20,7 +20,12 @@
 //! face tables list the same outward faces ([`CellKind::cgns_type`]).
 //! Medit (`.mesh`/`.meshb`) cells are written in the Gmsh orders above, unpermuted: meshio's
 //! Medit reader and writer apply no permutation to any kind, so meshio reads them as valid
-//! cells. (libMeshb's own documentation was not checked for its pyramid/prism figures.)
+//! cells. refine's `.meshb` writer (`ref_export.c`: pyramid "square basis is 0-1-2-3 (oriented
+//! counter clockwise like trias) and top vertex is 4") writes our pyramid as 1,2,3,0,4, a rotation
+//! of the same base, and our other kinds unpermuted. (libMeshb's own documentation was not
+//! checked.)
+//! UGRID (`.ugrid`, [`crate::io::ugrid`]) uses these orders except the pyramid, whose apex is its
+//! third node: `ugrid = ours[1, 0, 4, 2, 3]` ([`crate::io::ugrid::PYRAMID`]).
 //!
 //! Faces of each kind, oriented outward, are in [`CellKind::faces`].
 

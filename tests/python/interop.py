@@ -6,7 +6,8 @@ usage:
       Load MESH (.msh, .vtu, .su2, .mesh, .meshb) with meshio and, for .msh, with Gmsh (gmsh.open +
       gmsh.model.mesh.getElements); compare the element counts by meshio type name (tetra,
       pyramid, wedge, hexahedron, triangle, quad) and the total cell volume (within 1e-9
-      relative) with the expected values; for .msh also the physical group names. Exit 1 on
+      relative) with the expected values, and find every cell's volume positive in the reading
+      tool's node order (Gmsh's, which is meshio's); for .msh also the physical group names. Exit 1 on
       any mismatch. SU2 stores prisms in VTK order and meshio's SU2 reader keeps it (meshio's
       wedge is Gmsh's), so the wedges read from .su2 are permuted back before the volume.
   interop.py convert MSH VTU OUTDIR
@@ -32,13 +33,15 @@ GMSH_TYPES = {2: "triangle", 3: "quad", 4: "tetra", 5: "hexahedron", 6: "wedge",
 
 
 def volume(points, cells):
-    """Total volume of cells {type: (m, n) node arrays}: centroid joined to the face triangles."""
-    total = 0.0
+    """Total volume of cells {type: (m, n) node arrays} (centroid joined to the face triangles)
+    and the number of cells whose own volume is not positive."""
+    total, nonpositive = 0.0, 0
     for ctype, conn in cells.items():
         if ctype not in FACES or len(conn) == 0:
             continue
         x = points[conn]
         c = x.mean(axis=1)
+        per_cell = np.zeros(len(conn))
         for f in FACES[ctype]:
             fx = x[:, list(f)]
             if len(f) == 3:
@@ -47,11 +50,16 @@ def volume(points, cells):
                 m = fx.mean(axis=1)
                 parts = [(fx[:, i], fx[:, (i + 1) % 4], m) for i in range(4)]
             for a, b, d in parts:
-                total += float(np.einsum("ij,ij->i", a - c, np.cross(b - c, d - c)).sum()) / 6.0
-    return total
+                per_cell += np.einsum("ij,ij->i", a - c, np.cross(b - c, d - c)) / 6.0
+        total += float(per_cell.sum())
+        nonpositive += int((per_cell <= 0).sum())
+    return total, nonpositive
 
 
 def compare(label, counts, vol, expect, expected_volume, problems):
+    vol, nonpositive = vol
+    if nonpositive:
+        problems.append(f"{label}: {nonpositive} cells with a volume <= 0")
     for t, n in expect.items():
         if counts.get(t, 0) != n:
             problems.append(f"{label}: {counts.get(t, 0)} {t}, expected {n}")
@@ -74,7 +82,7 @@ def check_meshio(path, expect, expected_volume, problems):
         cells["wedge"] = cells["wedge"][:, [0, 2, 1, 3, 5, 4]]
     vol = volume(np.asarray(m.points, dtype=float)[:, :3], cells)
     compare("meshio", counts, vol, expect, expected_volume, problems)
-    print(f"meshio: {counts}, volume {vol!r}")
+    print(f"meshio: {counts}, volume {vol[0]!r}, {vol[1]} cells <= 0")
 
 
 def check_gmsh(path, expect, expected_volume, groups, problems):
@@ -100,7 +108,7 @@ def check_gmsh(path, expect, expected_volume, groups, problems):
         names = sorted(gmsh.model.getPhysicalName(d, t) for d, t in gmsh.model.getPhysicalGroups())
         if groups is not None and names != sorted(groups):
             problems.append(f"gmsh: physical groups {names}, expected {sorted(groups)}")
-        print(f"gmsh: {counts}, volume {vol!r}, physical groups {names}")
+        print(f"gmsh: {counts}, volume {vol[0]!r}, {vol[1]} cells <= 0, physical groups {names}")
     finally:
         gmsh.finalize()
 
