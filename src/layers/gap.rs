@@ -1,14 +1,15 @@
 //! Thin gaps: where the wall faces itself across less than two stack thicknesses, the fronts
 //! from the two sides meet at the medial surface between them, and the crossing guard ends
 //! their stacks there rather than let them cross. Such a stack is as thick as the gap allows,
-//! so it counts as reached (issue 7): the medial surface is the bisector of the two walls.
+//! so it counts as reached: the medial surface is the bisector of the two walls.
 //!
-//! A column that stopped early is gap-limited when the ray along its direction from its wall
-//! point meets the wall again, facing it (the two normals within [`FACING_ANGLE_DEG`] of
-//! opposite), and its top, with the layer it could not build, reaches half way across (with
-//! the two layers it could not build where the front closes on an axis, as in a bore). The
-//! fronts at a concave ridge do not face each other this way (the rays run along the other
-//! wall), so a stop there is never excused.
+//! A column that stopped early is gap-limited when the front above its top has no room for the
+//! layer it could not build: climbing the exact wall distance from the top (away from the
+//! nearest wall points, along a shock where two meet) gains less than that layer before the
+//! climb stalls at the medial surface of a gap (where two walls within [`FACING_ANGLE_DEG`] of
+//! facing each other meet: across a slot, at a slot's bottom corners and lips, in a narrow
+//! wedge). Where the front closes on an axis, as in a bore, two layers. The fronts at a
+//! concave ridge of a wider angle go on along its bisector, so a stop there is never excused.
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -87,28 +88,80 @@ fn reaches_medial_surface(
 ) -> bool {
     let (base, dir) = (columns.base[c], columns.dir[c]);
     let Some(first) = columns.spec[c].map(|s| s.first_height) else { return false };
-    let Some((across, t)) = bvh.first_hit(base, dir, OWN_WALL * first, |_| false) else { return false };
-    if surface.triangle_normal(t as usize).dot(dir) > -FACING_ANGLE_DEG.to_radians().cos() {
-        return false;
-    }
     let carrier = columns.carrier(c);
     let k = columns.layers[carrier];
-    let rise = (points[columns.node[carrier] as usize] - base).dot(dir);
+    let top = points[columns.node[carrier] as usize];
     // The layers it could not build (or, past its stack, its last one).
     let height = |j: u32| match columns.layer_height(carrier, j) {
         h if h > 0.0 => h,
         _ => columns.layer_height(carrier, k.max(1)),
     };
-    let next = height(k + 1);
+    let (next, after) = (height(k + 1), height(k + 2));
+    let room = room_above(bvh, top, columns.dir[carrier], next + after);
+    tracing::debug!(c, ?top, k, room, next, "room above a stopped stack");
+    if room < next {
+        return true;
+    }
     // A front closing on an axis (a bore narrower than twice the stack) shrinks around it as
     // it rises: the last layer short of the axis would be crushed along the front to a small
     // fraction of its width and cannot be built (the flange's 1 mm bore: six layers reach 75%
     // of its radius, a seventh would reach 97%). Where the wall across faces back and the
     // front closes, two layers short of the medial surface is as far as it goes.
-    let reaches = |layers: f64| rise + columns.scale[carrier] * layers >= 0.5 * across;
-    reaches(next)
-        || (reaches(next + height(k + 2))
-            && closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across, wall_edges))
+    let Some((across, t)) = bvh.first_hit(base, dir, OWN_WALL * first, |_| false) else { return false };
+    room < next + after
+        && surface.triangle_normal(t as usize).dot(dir) < -FACING_ANGLE_DEG.to_radians().cos()
+        && closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across, wall_edges)
+}
+
+/// Steps of a climb per length `reach` ([`room_above`]).
+const CLIMB_STEPS: f64 = 16.0;
+
+/// How much farther from the wall (up to `reach`) the front can get above `top`: climb the
+/// wall distance from `top` in steps of `reach / CLIMB_STEPS`, along `heading` (the column's
+/// direction: a top still on the wall has no other) or away from the nearest wall point, or where that step crosses a shock (another wall point becomes the nearest) along
+/// the shock, away from both; stop where no step gains `sin(FACING_ANGLE_DEG / 2)` of its
+/// length. That is the rise along the bisector of two walls at [`FACING_ANGLE_DEG`]: between
+/// walls that face each other more, the climb stalls at their medial surface.
+pub fn room_above(bvh: &TriangleBvh, top: DVec3, mut heading: DVec3, reach: f64) -> f64 {
+    let step = reach / CLIMB_STEPS;
+    let least_rise = (0.5 * FACING_ANGLE_DEG).to_radians().sin() * step;
+    let Some(start) = bvh.nearest(top) else { return f64::INFINITY };
+    let away_from = |x: DVec3, n: &crate::geometry::bvh::Nearest| (x - n.point).normalize_or_zero();
+    let (mut x, mut d) = (top, start.distance);
+    // Each step gains `least_rise` at least: the climb ends.
+    while d - start.distance < reach {
+        let Some(near) = bvh.nearest(x) else { break };
+        let gradient = away_from(x, &near);
+        let mut tried = Vec::with_capacity(3);
+        let mut moved = false;
+        for direction in [heading, gradient] {
+            if direction == DVec3::ZERO || tried.contains(&direction) {
+                continue;
+            }
+            tried.push(direction);
+            let y = x + step * direction;
+            let Some(at_y) = bvh.nearest(y) else { continue };
+            if at_y.distance >= d + least_rise {
+                (x, d, heading, moved) = (y, at_y.distance, direction, true);
+                break;
+            }
+            // Across a shock: along it, away from the walls on both sides.
+            let along = (direction + away_from(y, &at_y)).normalize_or_zero();
+            if along == DVec3::ZERO || tried.contains(&along) {
+                continue;
+            }
+            tried.push(along);
+            let z = x + step * along;
+            if let Some(at_z) = bvh.nearest(z).filter(|n| n.distance >= d + least_rise) {
+                (x, d, heading, moved) = (z, at_z.distance, along, true);
+                break;
+            }
+        }
+        if !moved {
+            break;
+        }
+    }
+    d - start.distance
 }
 
 /// Tilt (degrees) of the rays that probe whether the wall across curves around a column.
@@ -253,6 +306,50 @@ mod tests {
         let edges = wall_edges_at(&tube, &Topology::new(&tube), v as u32);
         assert!(edges.iter().any(|e| e.z.abs() < 1e-12), "an edge along the rim");
         assert!(closes_on_an_axis(&tube, &bvh, (base, dir, 1e-6), across, &edges));
+    }
+
+    /// A plane wall through `at` spanned by `u` and `v`, 40 across.
+    fn plane(at: DVec3, u: DVec3, v: DVec3) -> [[DVec3; 3]; 2] {
+        let (u, v) = (20.0 * u, 20.0 * v);
+        [[at - u - v, at + u - v, at + u + v], [at - u - v, at + u + v, at - u + v]]
+    }
+
+    fn walls(planes: &[[[DVec3; 3]; 2]]) -> TriangleBvh {
+        TriangleBvh::new(planes.iter().flatten().copied().collect())
+    }
+
+    #[test]
+    fn the_climb_stalls_at_the_medial_surface_of_a_gap() {
+        let (x, y, z) = (DVec3::X, DVec3::Y, DVec3::Z);
+        let tol = 0.02;
+        // Two parallel walls 1 apart: 0.05 above a top at 0.45.
+        let gap = walls(&[plane(DVec3::ZERO, x, y), plane(z, x, y)]);
+        assert!((room_above(&gap, 0.45 * z, z, 0.2) - 0.05).abs() < tol);
+        // A top still on the wall climbs along its column.
+        assert!(room_above(&gap, DVec3::ZERO, z, 0.2) >= 0.2);
+        // A slot 1 wide: from its bottom corner's bisector up to where the three walls are
+        // equally near (0.5 from each).
+        let slot = walls(&[plane(DVec3::ZERO, x, y), plane(DVec3::ZERO, y, z), plane(x, y, z)]);
+        let room = room_above(&slot, DVec3::new(0.3, 0.0, 0.3), z, 0.5);
+        assert!((room - 0.2).abs() < tol, "{room}");
+        // Across the mouth of a slot between two lips: the fronts from the lips meet over it,
+        // and a top low in the mouth has little room.
+        let lips = walls(&[plane(-20.0 * x, x, y), plane(20.0 * x + x, x, y)]);
+        assert!(room_above(&lips, DVec3::new(0.45, 0.0, 0.01), z, 0.2) < 0.1);
+    }
+
+    #[test]
+    fn the_climb_goes_on_along_a_concave_ridge_and_a_wedge_wider_than_facing_walls() {
+        let (x, y) = (DVec3::X, DVec3::Y);
+        for (opening, stalls) in [(90.0f64, false), (40.0, false), (20.0, true)] {
+            // A wedge along y, its faces at +-opening/2 from the bisector (x).
+            let half = (0.5 * opening).to_radians();
+            let (a, b) = (DVec3::new(half.cos(), 0.0, half.sin()), DVec3::new(half.cos(), 0.0, -half.sin()));
+            let wedge = walls(&[plane(20.0 * a, a, y), plane(20.0 * b, b, y)]);
+            let top = 0.3 * x + 0.02 * DVec3::Z;
+            let room = room_above(&wedge, top, DVec3::Z, 0.2);
+            assert_eq!(room < 0.1, stalls, "opening {opening}: room {room}");
+        }
     }
 
     #[test]
