@@ -1,8 +1,8 @@
 //! Benchmark of the layer stage on the bunny with 20 layers, h0 = 1e-4 of the bounding-box
-//! diagonal, r = 1.2 (issue 3's target: at least 2 million layer cells per second), in three
+//! diagonal, r = 1.2 (the target: at least 2 million layer cells per second), in three
 //! set-ups: `plain` (no tangential adaptivity), `adapted` (split and collapse to the wall's
 //! sizes, as `blmesh mesh` runs by default) and `refined` (to a sizing field with a refinement
-//! box of size 0.004 = half the bunny's shortest wall edge over a quarter of it; issue 4).
+//! box of size 0.004 = half the bunny's shortest wall edge over a quarter of it).
 //!
 //! `cargo bench --bench layers [-- CASE]` runs the stage several times and prints the median
 //! time, the cells per second and the peak memory (of the process: run one case for its own);

@@ -208,7 +208,11 @@ pub fn run(
         options,
         progress: &progress,
     };
-    let (Round { layered, mesh, core, .. }, peel) = stages.run_peeling(&mut timings)?;
+    let (Round { layered, mut mesh, core, .. }, peel) = stages.run_peeling(&mut timings)?;
+    let unused = mesh.drop_unused_points();
+    if unused > 0 {
+        tracing::info!(unused, "points used by no cell left out");
+    }
     warnings.extend(peel.failed_round.clone());
     let layer_summary = layer_summary(&layered, &surface, &topology, &features);
     let check = timings.time("check", || quality::check(&mesh));

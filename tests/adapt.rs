@@ -1,4 +1,4 @@
-//! Tangential adaptivity (issue 4): the front's edges are split and collapsed to the sizing
+//! Tangential adaptivity: the front's edges are split and collapsed to the sizing
 //! field while the layers march, fans stay bounded, and stacks end at isotropy. Every mesh goes
 //! through the checker.
 

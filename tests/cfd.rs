@@ -1,4 +1,4 @@
-//! CFD set-ups (issue 6): internal flow and patches without layers whose columns slide.
+//! CFD set-ups: internal flow and patches without layers whose columns slide.
 //! Every mesh goes through `quality::check` (inside `pipeline::run`, and again here).
 
 use std::collections::HashSet;
@@ -183,7 +183,7 @@ fn input_patch_border_edges(s: &Surface, name: &str) -> usize {
     count.values().filter(|&&n| n == 1).count()
 }
 
-/// Known bug (issues 5 and 7): stacks that grow on to isotropy (`count = "auto"`, and transition
+/// Known bug: stacks that grow on to isotropy (`count = "auto"`, and transition
 /// layers, which the pipeline turns off on sliding planes for this reason) cross each other in
 /// the symmetry plane where the upper and lower fronts of the trailing edge meet at the root:
 /// the core fails with "front triangle ... and wall triangle ..." (the plane's re-triangulation)

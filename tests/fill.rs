@@ -1,4 +1,4 @@
-//! Core fill (issue 5): layers from the pipeline, then TetGen between the front and a farfield.
+//! Core fill: layers from the pipeline, then TetGen between the front and a farfield.
 //! Every mesh passes the checker, the cell volumes add up to the farfield's minus the body's,
 //! and the front is kept exactly: every top face of the layers is a face of exactly one core
 //! cell (a tetrahedron on a triangle, a pyramid on a quad) and no point is added on it.
@@ -140,7 +140,7 @@ fn sphere_with_layers() {
     let layers = layered(&wall, &config(&wall, 20));
     let stats = fill_and_check("sphere", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
     assert_eq!(stats.pyramids, 0, "a smooth sphere has no fans, so no quads");
-    // The core quality bar of issue 5, reached by our improvement (TetGen alone: 6.6 degrees).
+    // The core quality bar, reached by our improvement (TetGen alone: 6.6 degrees).
     assert!(stats.min_dihedral >= 10.0, "sphere: core min dihedral {:.2}", stats.min_dihedral);
     assert_eq!(stats.quality.slivers.count, 0);
 }
@@ -226,7 +226,7 @@ fn a_refinement_region_refines_the_core() {
     assert!(before > 1.6 * inside, "without the region: {before}");
 }
 
-/// The core quality bar of issue 5 on the box (20 layers, then transition layers to isotropy):
+/// The core quality bar on the box (20 layers, then transition layers to isotropy):
 /// with the seeds over the front, TetGen and our pass leave no tetrahedron below 10 degrees
 /// (with 20 layers and no transition, slivers down to 1.5 degrees stay on the pyramids over the
 /// fans' long thin quads along the box's edges).
@@ -403,7 +403,7 @@ fn worst_core_tetrahedra() {
     }
 }
 
-/// No size jump (issue 5): with `count = "auto"` the layers end isotropic, and the seeds over
+/// No size jump: with `count = "auto"` the layers end isotropic, and the seeds over
 /// the front make the first core tetrahedron on a front triangle about as tall as the last
 /// layer under it. Measured over every front triangle (those on the ramps between stacks
 /// ending a layer apart too): 99.9% within [1/r, r] on this sphere (examples/sphere.stl:

@@ -1,4 +1,4 @@
-//! Boundary layers on smooth and convex walls (issue 3): every mesh goes through the checker;
+//! Boundary layers on smooth and convex walls: every mesh goes through the checker;
 //! the box and the sphere must reach every layer everywhere, and their outermost layer must lie
 //! on the exact offset surface (faces, cylinders at the ridges, spheres at the corners).
 
@@ -119,7 +119,7 @@ fn sphere_gets_all_layers_on_the_exact_offset() {
 }
 
 /// Real organic surfaces (mild concavity): the layers are valid and conforming everywhere;
-/// columns may stop early near concave folds until the entropy collapse lands (issue 7), so
+/// columns may stop early near concave folds where the entropy collapse does not hold, so
 /// the coverage is reported, and most of the wall must get the full stack.
 #[test]
 fn spot_and_bunny_layers_are_valid() {
@@ -148,7 +148,7 @@ fn spot_and_bunny_layers_are_valid() {
     }
 }
 
-/// `count = "auto"` (issue 4): every column of the box and the sphere ends its stack where its
+/// `count = "auto"`: every column of the box and the sphere ends its stack where its
 /// next layer would be as high as the front is wide (or the wall, where a convex front widens
 /// faster than the layers grow), the mesh passes the checker, every wall vertex completes its
 /// stack, and the stacks end smoothly: neighbouring thicknesses within two growth ratios.
@@ -180,7 +180,7 @@ fn auto_count_stops_at_isotropy_smoothly() {
     }
 }
 
-/// Transition layers (issue 5, the default): after a fixed count of thin layers, the stacks of
+/// Transition layers (the default): after a fixed count of thin layers, the stacks of
 /// the box and the sphere go on growing until their cells are isotropic, as with
 /// `count = "auto"`; every stack counts as full once it has the count, and the last layers end
 /// within the growth ratio of the front's size. Without them, the stacks end at the count.
@@ -218,7 +218,7 @@ fn transition_layers_carry_a_fixed_count_to_isotropy() {
     }
 }
 
-/// Patch-wise layer settings (issue 6): the arrow's fins get a first height 4 times smaller than
+/// Patch-wise layer settings: the arrow's fins get a first height 4 times smaller than
 /// the body, its cap 2 times. The first heights are graded across the patch borders, so
 /// neighbouring stacks differ by at most one growth ratio (measured over all wall edges, apart
 /// from the few columns that stop early).

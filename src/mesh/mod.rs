@@ -263,4 +263,53 @@ impl VolumeMesh {
     pub fn cells(&self) -> impl Iterator<Item = (CellKind, &[u32])> {
         self.blocks.iter().flat_map(|b| b.iter().map(move |c| (b.kind, c)))
     }
+
+    /// Leave out the points no cell uses (solvers and converters count them as errors) and
+    /// renumber the rest in their order; returns how many went.
+    pub fn drop_unused_points(&mut self) -> usize {
+        let mut new_id = vec![u32::MAX; self.points.len()];
+        for b in &self.blocks {
+            for &n in &b.nodes {
+                new_id[n as usize] = 0;
+            }
+        }
+        let mut kept = 0u32;
+        for id in new_id.iter_mut().filter(|id| **id == 0) {
+            *id = kept;
+            kept += 1;
+        }
+        let dropped = self.points.len() - kept as usize;
+        if dropped == 0 {
+            return 0;
+        }
+        let mut i = 0;
+        self.points.retain(|_| {
+            i += 1;
+            new_id[i - 1] != u32::MAX
+        });
+        let renumber = |n: &mut u32| *n = new_id[*n as usize];
+        self.blocks.iter_mut().for_each(|b| b.nodes.iter_mut().for_each(renumber));
+        let faces = &mut self.boundary;
+        faces.triangles.iter_mut().flatten().chain(faces.quads.iter_mut().flatten()).for_each(renumber);
+        dropped
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn unused_points_are_dropped_and_the_rest_renumbered() {
+        let mut mesh = VolumeMesh::default();
+        mesh.points = (0..6).map(|i| DVec3::splat(i as f64)).collect();
+        mesh.push_cell(CellKind::Tetrahedron, &[1, 3, 4, 5], 0);
+        mesh.boundary.triangles.push([1, 4, 3]);
+        mesh.boundary.triangle_patch.push(0);
+        assert_eq!(mesh.drop_unused_points(), 2);
+        assert_eq!(mesh.points, [1.0, 3.0, 4.0, 5.0].map(DVec3::splat));
+        assert_eq!(mesh.block(CellKind::Tetrahedron).cell(0), [0, 1, 2, 3]);
+        assert_eq!(mesh.boundary.triangles, [[0, 2, 1]]);
+        assert_eq!(mesh.drop_unused_points(), 0);
+    }
 }
