@@ -10,6 +10,7 @@
 //! Shared vocabulary lives in [`geometry`] (points, exact predicates), [`surface`] (the input
 //! triangle surface with named patches) and [`mesh`] (the hybrid volume mesh and its node orders).
 
+pub mod api;
 pub mod cli;
 pub mod config;
 pub mod fill;
