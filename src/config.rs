@@ -285,7 +285,7 @@ impl Config {
     /// which arrives as JSON).
     pub fn from_table(mut table: toml::Table) -> Result<Config, String> {
         resolve_yplus(&mut table).map_err(|e| e.to_string())?;
-        table.try_into().map_err(|e: toml::de::Error| e.to_string())
+        table.try_into().map_err(|e: toml::de::Error| e.to_string().trim_end().to_owned())
     }
 
     pub fn feature_angle(&self) -> f64 {

@@ -1,4 +1,4 @@
-//! The `mesh` pipeline, stage by stage (DESIGN.md): validate, analyse features, normals,
+//! The `mesh` pipeline, stage by stage (docs/design.md): validate, analyse features, normals,
 //! layers, (core), check; with timings and the run's report.
 
 use serde::Serialize;

@@ -1,4 +1,4 @@
-//! Concave ridges and corners (issue 7): the layers never stop early where fronts meet; the
+//! Concave ridges and corners: the layers never stop early where fronts meet; the
 //! columns merge on the bisectors (the entropy solution) and every mesh passes the checker.
 
 mod common;
@@ -9,6 +9,10 @@ use blmesh::layers::TOP_PATCH;
 use blmesh::pipeline::{run, MeshOptions, MeshOutput};
 use blmesh::progress::Progress;
 use blmesh::surface::{shapes, Surface};
+
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
 
 /// `layers` layers growing by 1.2 from `h0`; returns the output and the total thickness.
 fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
@@ -28,10 +32,9 @@ fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
     (out, h0 * (1.2f64.powi(layers as i32) - 1.0) / 0.2)
 }
 
-/// Issue 7's spec on a shared geometry: 10 layers from 1e-3 of its diagonal.
+/// The concave-ridge set-up on a shared geometry: 10 layers from 1e-3 of its diagonal.
 fn mesh_shared(name: &str) -> MeshOutput {
-    let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
-    let surface = blmesh::io::read_surface(path.as_ref()).expect("reads");
+    let surface = blmesh::io::read_surface(&shared_geometry(name)).expect("reads");
     let h0 = 1e-3 * surface.bounding_box().diagonal();
     mesh(&surface, h0, 10).0
 }
@@ -107,7 +110,7 @@ fn notched_box_layers_merge_at_the_concave_corner() {
     assert!(err < 0.02, "top front off the exact offset by {:.2}% of the thickness", 100.0 * err);
 }
 
-/// Straight concave ridges of 60, 90 and 120 degrees (issue 7's wedges: a V groove in a block):
+/// Straight concave ridges of 60, 90 and 120 degrees (wedges: a V groove in a block):
 /// the fronts of the groove's walls meet on its bisector plane and keep marching, every wall
 /// vertex gets its full stack, and the top front lies on the exact offset.
 #[test]
@@ -139,7 +142,7 @@ fn cutcube_fandisk_flange_and_arrow_are_accepted_by_a_finite_volume_solver() {
     assert!(rejected.is_empty(), "{}", rejected.join("\n"));
 }
 
-/// Thin gaps (issue 7): `mech_test_gapdetection.obj` has holes narrower than two stack
+/// Thin gaps: `mech_test_gapdetection.obj` has holes narrower than two stack
 /// thicknesses. Their fronts stop where they meet, at the medial surface, and those stacks
 /// count as full; the rest of the wall keeps its layers, and the mesh is valid.
 #[test]
@@ -156,7 +159,7 @@ fn thin_gaps_stop_at_the_medial_surface() {
     assert!(l.full_coverage >= 0.85, "full stacks (or gap-limited) at {:.3} of the wall", l.full_coverage);
 }
 
-/// The cut cube, fandisk, the flange and the arrow with issue 7's spec (10 layers from 1e-3 of
+/// The cut cube, fandisk, the flange and the arrow with the concave-ridge set-up (10 layers from 1e-3 of
 /// the diagonal): concave ridges that meet saddles, thin wall triangles along them, a 1 mm
 /// bore, fins on a body with blunt edges. Full stacks (or limited by a thin gap) within two
 /// thicknesses of a concave ridge, without transition layers: the cut cube 100% (its 4 such
@@ -228,11 +231,11 @@ fn jittered(surface: &Surface) -> Surface {
 }
 
 /// The 60-degree groove meshed obliquely: every stack should stay full, the top front on the
-/// exact offset. Known to fail (issue 7): 22 columns stop where the groove's walls meet the
+/// exact offset. Known to fail: 22 columns stop where the groove's walls meet the
 /// block's ends (y = 0 and 2: fans at the lips' convex edges meeting the groove), 36 without the
 /// corner rule of the entropy collapse, 26 without the merge of flat tops.
 #[test]
-#[ignore = "issue 7: columns stop at the ends of an obliquely meshed groove"]
+#[ignore = "known to fail: columns stop at the ends of an obliquely meshed groove"]
 fn an_obliquely_meshed_groove_keeps_every_layer() {
     let straight = shapes::grooved_block(60.0, 8);
     let surface = jittered(&straight);
@@ -246,7 +249,7 @@ fn an_obliquely_meshed_groove_keeps_every_layer() {
     assert!(err < 0.02, "top front off the exact offset by {:.2}% of the thickness", 100.0 * err);
 }
 
-/// A step lower than the layers are thick (issue 7): the riser's fronts are overtaken by the
+/// A step lower than the layers are thick: the riser's fronts are overtaken by the
 /// floor's and the top's (a fin's trailing edge standing near the body's end on the arrow). Its
 /// columns merge into the columns on time (the first-arrival rule over the whole wall); at its
 /// ends, saddle corners where the riser meets the side walls, the corner's fan and the foot's

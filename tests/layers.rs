@@ -1,4 +1,4 @@
-//! Boundary layers on smooth and convex walls (issue 3): every mesh goes through the checker;
+//! Boundary layers on smooth and convex walls: every mesh goes through the checker;
 //! the box and the sphere must reach every layer everywhere, and their outermost layer must lie
 //! on the exact offset surface (faces, cylinders at the ridges, spheres at the corners).
 
@@ -13,10 +13,14 @@ use blmesh::pipeline::{run, MeshOptions, MeshOutput};
 use blmesh::progress::Progress;
 use blmesh::surface::{shapes, Surface};
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 const LAYERS: u32 = 20;
 const GROWTH: f64 = 1.2;
 
-/// 20 layers, h0 = 1e-4 of the bounding-box diagonal, r = 1.2 (the issue's set-up).
+/// 20 layers, h0 = 1e-4 of the bounding-box diagonal, r = 1.2 (the layer benchmark's set-up).
 fn mesh_layers(surface: &Surface) -> (MeshOutput, f64) {
     let h0 = 1e-4 * surface.bounding_box().diagonal();
     let config = Config {
@@ -119,13 +123,12 @@ fn sphere_gets_all_layers_on_the_exact_offset() {
 }
 
 /// Real organic surfaces (mild concavity): the layers are valid and conforming everywhere;
-/// columns may stop early near concave folds until the entropy collapse lands (issue 7), so
+/// columns may stop early near concave folds where the entropy collapse does not reach, so
 /// the coverage is reported, and most of the wall must get the full stack.
 #[test]
 fn spot_and_bunny_layers_are_valid() {
     for (name, min_coverage) in [("spot.obj", 0.8), ("bunny_closed_herholz.off", 0.8)] {
-        let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
-        let surface = blmesh::io::read_surface(std::path::Path::new(&path)).unwrap();
+        let surface = blmesh::io::read_surface(&shared_geometry(name)).unwrap();
         let (out, _) = mesh_layers(&surface);
         let r = &out.report;
         common::assert_valid_for_a_solver(name, &r.check);
@@ -148,7 +151,7 @@ fn spot_and_bunny_layers_are_valid() {
     }
 }
 
-/// `count = "auto"` (issue 4): every column of the box and the sphere ends its stack where its
+/// `count = "auto"`: every column of the box and the sphere ends its stack where its
 /// next layer would be as high as the front is wide (or the wall, where a convex front widens
 /// faster than the layers grow), the mesh passes the checker, every wall vertex completes its
 /// stack, and the stacks end smoothly: neighbouring thicknesses within two growth ratios.
@@ -180,7 +183,7 @@ fn auto_count_stops_at_isotropy_smoothly() {
     }
 }
 
-/// Transition layers (issue 5, the default): after a fixed count of thin layers, the stacks of
+/// Transition layers (the default): after a fixed count of thin layers, the stacks of
 /// the box and the sphere go on growing until their cells are isotropic, as with
 /// `count = "auto"`; every stack counts as full once it has the count, and the last layers end
 /// within the growth ratio of the front's size. Without them, the stacks end at the count.
@@ -218,16 +221,13 @@ fn transition_layers_carry_a_fixed_count_to_isotropy() {
     }
 }
 
-/// Patch-wise layer settings (issue 6): the arrow's fins get a first height 4 times smaller than
+/// Patch-wise layer settings: the arrow's fins get a first height 4 times smaller than
 /// the body, its cap 2 times. The first heights are graded across the patch borders, so
 /// neighbouring stacks differ by at most one growth ratio (measured over all wall edges, apart
 /// from the few columns that stop early).
 #[test]
 fn patch_settings_meet_without_steps() {
-    let surface = blmesh::io::read_surface(
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/arrow_cape.stl").as_ref(),
-    )
-    .expect("the arrow reads");
+    let surface = blmesh::io::read_surface(&shared_geometry("arrow_cape.stl")).expect("the arrow reads");
     let config = Config::from_toml_str(
         "[layers]\nfirst_height = 0.01\ncount = 10\ntransition = false\n\
          [[patch]]\nmatch = \"fin.*\"\nfirst_height = 0.0025\n\

@@ -1,4 +1,4 @@
-//! The first core points above the front (issue 5, no size jump at the layer top): a point over
+//! The first core points above the front (no size jump at the layer top): a point over
 //! every front vertex at the height of the last layer under it, leaning from the front's normal
 //! towards the column's last step where the vertex tops a column's prisms.
 //! Left to itself, the mesher's Delaunay refinement puts the fourth node of the tetrahedron on a

@@ -1,4 +1,4 @@
-//! The size jump at the top of the layers (issue 5): over every front triangle, the height of
+//! The size jump at the top of the layers: over every front triangle, the height of
 //! the core tetrahedron on it (its fourth node's distance from the triangle's plane) over the
 //! height of the last layer under it. A smooth transition keeps the ratio within [1/r, r]; an
 //! isotropic core on thin last layers gives ratios far above r.

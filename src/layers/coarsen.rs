@@ -1,4 +1,4 @@
-//! Tangential collapse of short front edges (issue 4, DESIGN.md "Tangential adaptivity"): a
+//! Tangential collapse of short front edges (tangential adaptivity): a
 //! front edge whose proposed top is shorter than [`COLLAPSE_LENGTH`] against its size
 //! ([`EdgeSizes::collapse_length`]: the target, or a part of its length on the wall where shorter)
 //! merges its two columns into one, as the entropy collapse does ([`super::entropy::collapse`]):

@@ -1,7 +1,7 @@
 //! Thin gaps: where the wall faces itself across less than two stack thicknesses, the fronts
 //! from the two sides meet at the medial surface between them, and the crossing guard ends
 //! their stacks there rather than let them cross. Such a stack is as thick as the gap allows,
-//! so it counts as reached (issue 7): the medial surface is the bisector of the two walls.
+//! so it counts as reached: the medial surface is the bisector of the two walls.
 //!
 //! A column that stopped early is gap-limited when the ray along its direction from its wall
 //! point meets the wall again, facing it (the two normals within [`FACING_ANGLE_DEG`] of

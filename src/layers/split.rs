@@ -1,4 +1,4 @@
-//! Tangential split of front edges (issue 4, DESIGN.md "Tangential adaptivity"): a front edge
+//! Tangential split of front edges (tangential adaptivity): a front edge
 //! whose proposed top is longer than [`SPLIT_LENGTH`] in the metric gets a new column at its
 //! middle, born at this layer's top. Fan edges (two copies of one wall vertex) start with no
 //! length and open like the distance times the fan angle; splitting them keeps fans bounded.

@@ -1,4 +1,4 @@
-//! Edge swaps on the front (issue 4, DESIGN.md "Tangential adaptivity"): where two front
+//! Edge swaps on the front (tangential adaptivity): where two front
 //! triangles `(a, b, c)` and `(b, a, d)` would top out badly shaped (splits fan long edges from
 //! their middle; columns converge), their shared edge is swapped for `(c, d)`: the new front has
 //! the triangles `(c, a, d)` and `(d, b, c)`.

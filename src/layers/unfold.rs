@@ -1,5 +1,5 @@
 //! After the march: undo the caps and folds of the final front, which the core fill cannot
-//! mesh without slivers (issue 5).
+//! mesh without slivers.
 //!
 //! A cap is a front triangle with a corner nearly on its opposite edge; a fold is a front edge
 //! where the two triangles close on the core's side to a thin wedge. Over either, every
