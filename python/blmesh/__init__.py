@@ -66,6 +66,7 @@ def check(path_or_mesh):
     return json.loads(_native.check_file(os.fspath(path_or_mesh)))
 
 
-def info(surface, feature_angle=30.0):
-    """Describe a surface file as `blmesh info --json` does (also an invalid one: `validation`)."""
+def info(surface, feature_angle=None):
+    """Describe a surface file as `blmesh info --json` does (also an invalid one: `validation`);
+    feature_angle in degrees, 30 by default."""
     return json.loads(_native.info(os.fspath(surface), feature_angle))

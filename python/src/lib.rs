@@ -7,7 +7,6 @@ use std::sync::{Arc, Mutex};
 
 use blmesh::api::{self, Settings};
 use blmesh::config::Config;
-use blmesh::mesh::CellKind;
 use blmesh::pipeline::{MeshError, MeshOutput};
 use blmesh::progress::Progress;
 use pyo3::exceptions::PyRuntimeError;
@@ -139,16 +138,11 @@ fn check_json(report: &blmesh::quality::CheckReport) -> String {
 
 /// The description (JSON) of a surface file.
 #[pyfunction]
-#[pyo3(signature = (path, feature_angle=blmesh::config::DEFAULT_FEATURE_ANGLE))]
-fn info(py: Python<'_>, path: PathBuf, feature_angle: f64) -> PyResult<String> {
+#[pyo3(signature = (path, feature_angle=None))]
+fn info(py: Python<'_>, path: PathBuf, feature_angle: Option<f64>) -> PyResult<String> {
+    let feature_angle = feature_angle.unwrap_or(blmesh::config::DEFAULT_FEATURE_ANGLE);
     let info = py.detach(|| api::surface_info(&path, feature_angle)).map_err(|e| err(py, Kind::Input, &e))?;
     serde_json::to_string(&info).map_err(|e| raise(py, Kind::Input, e.to_string()))
-}
-
-/// `vtk_nodes[i] = our_nodes[perm[i]]` for a cell kind named as in `NativeMesh.cells`.
-#[pyfunction]
-fn vtk_permutation(kind: &str) -> Option<Vec<usize>> {
-    CellKind::ALL.into_iter().find(|k| k.name() == kind).map(|k| k.vtk_permutation().to_vec())
 }
 
 /// A volume mesh made by `mesh`, with its report and the config it was made with (the patch
@@ -255,7 +249,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(mesh, m)?)?;
     m.add_function(wrap_pyfunction!(check_file, m)?)?;
     m.add_function(wrap_pyfunction!(info, m)?)?;
-    m.add_function(wrap_pyfunction!(vtk_permutation, m)?)?;
     m.add_class::<NativeMesh>()?;
     m.add("__version__", env!("CARGO_PKG_VERSION"))?;
     m.add("CGNS", cfg!(feature = "cgns"))?;

@@ -175,9 +175,11 @@ def test_to_meshio_round_trips_through_a_file(box_mesh, tmp_path):
     assert report["validity"]["invalid_cells"] == 0, report["validity"]
 
 
-def test_to_pyvista_cells_have_positive_volume(box_mesh):
+def test_to_pyvista_cells_are_positive_and_fill_the_domain(box_mesh):
     pytest.importorskip("pyvista")
     grid = box_mesh.to_pyvista()
     assert grid.n_cells == sum(len(n) for n in box_mesh.cells.values())
     volumes = grid.compute_cell_sizes(length=False, area=False)["Volume"]
     assert volumes.min() > 0
+    assert volumes.sum() == pytest.approx(box_mesh.report["check"]["volume"]["cells"], rel=1e-9)
+    assert len(grid.cell_data["zone"]) == grid.n_cells
