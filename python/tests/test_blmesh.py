@@ -183,3 +183,27 @@ def test_to_pyvista_cells_are_positive_and_fill_the_domain(box_mesh):
     assert volumes.min() > 0
     assert volumes.sum() == pytest.approx(box_mesh.report["check"]["volume"]["cells"], rel=1e-9)
     assert len(grid.cell_data["zone"]) == grid.n_cells
+
+
+def test_other_threads_run_while_meshing():
+    """The GIL is released while meshing: a ticking thread is never held up for long."""
+    import threading
+    import time
+
+    ticks, stop = [time.perf_counter()], threading.Event()
+
+    def tick():
+        while not stop.is_set():
+            ticks.append(time.perf_counter())
+            time.sleep(0.001)
+
+    thread = threading.Thread(target=tick)
+    thread.start()
+    start = time.perf_counter()
+    try:
+        blmesh.mesh(BOX, layers=5)
+    finally:
+        stop.set()
+        thread.join()
+    took = time.perf_counter() - start
+    assert max(b - a for a, b in zip(ticks, ticks[1:])) < max(0.25, took / 4), took
