@@ -1,5 +1,5 @@
 //! Benchmark of the layer stage on the bunny with 20 layers, h0 = 1e-4 of the bounding-box
-//! diagonal, r = 1.2 (the target: at least 2 million layer cells per second), in three
+//! diagonal, r = 1.2 (target: at least 2 million layer cells per second), in three
 //! set-ups: `plain` (no tangential adaptivity), `adapted` (split and collapse to the wall's
 //! sizes, as `blmesh mesh` runs by default) and `refined` (to a sizing field with a refinement
 //! box of size 0.004 = half the bunny's shortest wall edge over a quarter of it).
@@ -21,12 +21,14 @@ use blmesh::surface::features::Features;
 use blmesh::surface::topology::Topology;
 use blmesh::surface::validate::{validate, ValidationOptions};
 
-const BUNNY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/bunny_closed_herholz.off");
+#[path = "../tests/common/shared.rs"]
+mod shared;
 
 fn main() {
     let full = std::env::args().any(|a| a == "--bench");
     let runs = if full { 7 } else { 1 };
-    let mut surface = blmesh::io::read_surface(BUNNY.as_ref()).expect("the bunny reads");
+    let mut surface = blmesh::io::read_surface(&shared::shared_geometry("bunny_closed_herholz.off"))
+        .expect("the bunny reads");
     validate(&mut surface, &ValidationOptions::default()).expect("the bunny is valid");
     let body_size = surface.bounding_box().diagonal();
     let topology = Topology::new(&surface);

@@ -4,7 +4,8 @@
 # and its tools (libcgns-dev for the cargo feature `cgns`, cgns-convert for cgnscheck and
 # cgns_to_vtk in the tests),
 # the system libraries the Gmsh Python wheel loads, and a venv with gmsh + meshio (used by the
-# interoperability tests that read our files back with other tools), and OpenFOAM (checkMesh and
+# interoperability tests that read our files back with other tools) and maturin + pytest (to
+# build and test the Python package), and OpenFOAM (checkMesh and
 # potentialFoam for tests/foam.rs; its tools find their etc/ through WM_PROJECT_DIR=/usr/share/openfoam,
 # which the tests set, so Debian's noisy etc/bashrc need not be sourced). Idempotent.
 set -euo pipefail
@@ -33,5 +34,5 @@ if [ ! -x .venv/bin/python ]; then
   python3 -m venv .venv
 fi
 # scipy: ../shared/bench/measure.py (the README's peer metric) needs it.
-.venv/bin/python -c "import gmsh, meshio, numpy, scipy" 2>/dev/null || \
-  .venv/bin/pip install -q gmsh==4.15.2 meshio==5.3.5 numpy scipy
+.venv/bin/python -c "import gmsh, meshio, numpy, scipy, maturin, pytest" 2>/dev/null || \
+  .venv/bin/pip install -q gmsh==4.15.2 meshio==5.3.5 numpy scipy "maturin>=1.5,<2" pytest

@@ -6,15 +6,13 @@
 use std::path::{Path, PathBuf};
 use std::process::ExitCode;
 
-use anyhow::{bail, Context, Result};
+use anyhow::Result;
 use clap::{Args, Parser, Subcommand};
 
-use crate::config::{Config, LayerCount, Role};
-use crate::io::{self, MeshFormat};
-use crate::pipeline::{self, MeshOptions};
+use crate::api::{self, Settings};
+use crate::config::Config;
 use crate::progress::Progress;
-use crate::quality;
-use crate::surface::info::{SurfaceInfo, ValidationSummary};
+use crate::surface::info::ValidationSummary;
 use crate::yplus::FlowConditions;
 
 /// Exit code for invalid input or a failed run (clap itself uses 2 for bad usage).
@@ -94,38 +92,8 @@ struct MeshArgs {
     /// TOML configuration file (flags override it).
     #[arg(long)]
     config: Option<PathBuf>,
-    /// First layer height h0 (surface units).
-    #[arg(long, allow_negative_numbers = true)]
-    first_height: Option<f64>,
-    /// Growth ratio r (layer k is h0 r^k high).
-    #[arg(long, allow_negative_numbers = true)]
-    growth: Option<f64>,
-    /// Number of layers, or "auto" to stop where cells become isotropic.
-    #[arg(long)]
-    layers: Option<LayerCount>,
-    /// Total layer thickness (instead of --layers).
-    #[arg(long, conflicts_with = "layers", allow_negative_numbers = true)]
-    thickness: Option<f64>,
-    /// Edges turning more than this (degrees) are ridges.
-    #[arg(long, allow_negative_numbers = true)]
-    feature_angle: Option<f64>,
-    /// Largest angle (degrees) between neighbouring normals of a fan at a convex ridge.
-    #[arg(long, allow_negative_numbers = true)]
-    fan_angle: Option<f64>,
-    /// Write only the layers (no core tetrahedra).
-    #[arg(long)]
-    no_core: bool,
-    /// March again at most N times with the stacks under the core's slivers a layer lower
-    /// (default 8; 0: never).
-    #[arg(long, value_name = "N")]
-    peel_rounds: Option<usize>,
-    /// Do not split or collapse the layers' front edges to the tangential sizes (tangential adaptivity).
-    #[arg(long)]
-    no_adapt: bool,
-    /// Stop at the layer count or thickness even where the last layer is still thinner than the
-    /// front is wide (no transition layers up to isotropic cells).
-    #[arg(long)]
-    no_transition: bool,
+    #[command(flatten)]
+    settings: Settings,
     /// Write MSH as ASCII instead of binary.
     #[arg(long)]
     ascii: bool,
@@ -158,26 +126,10 @@ pub fn main() -> ExitCode {
     match result {
         Ok(code) => code,
         Err(e) => {
-            eprintln!("error: {}", error_message(&e));
+            eprintln!("error: {}", api::error_message(&e));
             ExitCode::from(EXIT_FAILURE)
         }
     }
-}
-
-/// The error and its causes, each once: our error types already print their source in their own
-/// message, which `{:#}` would repeat.
-fn error_message(e: &anyhow::Error) -> String {
-    let mut message = String::new();
-    for cause in e.chain() {
-        let text = cause.to_string();
-        if !message.contains(&text) {
-            if !message.is_empty() {
-                message.push_str(": ");
-            }
-            message.push_str(&text);
-        }
-    }
-    message
 }
 
 fn init_logging(verbose: u8) {
@@ -192,11 +144,7 @@ fn init_logging(verbose: u8) {
 }
 
 fn info(path: &Path, json: bool, feature_angle: f64) -> Result<ExitCode> {
-    if !(feature_angle > 0.0 && feature_angle < 180.0) {
-        bail!("--feature-angle {feature_angle} must be between 0 and 180 degrees");
-    }
-    let surface = io::read_surface(path)?;
-    let info = SurfaceInfo::compute(&surface, feature_angle);
+    let info = api::surface_info(path, feature_angle)?;
     if json {
         print_out(&serde_json::to_string_pretty(&info)?);
     } else {
@@ -210,51 +158,29 @@ fn info(path: &Path, json: bool, feature_angle: f64) -> Result<ExitCode> {
 }
 
 fn check(path: &Path, json: bool) -> Result<ExitCode> {
-    let mesh = io::read_volume_mesh(path)?;
-    let report = quality::check(&mesh);
+    let report = api::check_file(path)?;
     if json {
         print_out(&serde_json::to_string_pretty(&report)?);
     } else {
         print_out(&format!("{}\n{report}", path.display()));
     }
-    let accepted = report.is_valid() && report.fv.rejection().is_none();
-    Ok(if accepted { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
-}
-
-/// The role of every patch of the mesh: the config's, except that a patch the config leaves a
-/// wall by default but that blmesh made (the farfield, the layer top) gets its own role.
-fn patch_roles(patch_names: &[String], config: &Config) -> Vec<Role> {
-    patch_names
-        .iter()
-        .map(|name| match config.patch_settings(name).0 {
-            Role::Wall => io::cgns::default_role(name),
-            role => role,
-        })
-        .collect()
+    Ok(if api::accepted(&report) { ExitCode::SUCCESS } else { ExitCode::from(EXIT_FAILURE) })
 }
 
 fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
-    let format = MeshFormat::from_path(&args.output, args.ascii).with_context(|| {
-        format!("{}: unknown output format (expected {})", args.output.display(), io::MESH_EXTENSIONS)
-    })?;
-    if let Some(why) = format.unavailable() {
-        bail!("{}: {why}", args.output.display());
-    }
-    let config = mesh_config(args)?;
-    let surface = io::read_surface(&args.input)?;
-    let options = MeshOptions { core: !args.no_core };
-    let out = pipeline::run(surface, &config, &options, progress)?;
-    let roles = patch_roles(&out.mesh.patch_names, &config);
-    io::write_volume_mesh_with_roles(&args.output, &out.mesh, format, &roles)
-        .with_context(|| format!("{}: cannot write", args.output.display()))?;
+    let format = api::output_format(&args.output, args.ascii)?;
+    let config = match &args.config {
+        Some(path) => Config::from_toml_file(path)?,
+        None => Config::default(),
+    };
+    let config = args.settings.apply(config)?;
+    let out = api::mesh_file(&args.input, &config, args.settings.no_core, progress)?;
+    api::write_mesh(&args.output, &out.mesh, format, &config)?;
     if let Some(report_path) = &args.report {
-        let text = serde_json::to_string_pretty(&out.report)?;
-        io::write_atomic(report_path, |w| w.write_all(text.as_bytes()))
-            .with_context(|| format!("{}: cannot write", report_path.display()))?;
+        api::write_report(report_path, &out)?;
     }
     if let Some(dir) = &args.pictures {
-        crate::picture::write_overview(&out.mesh, dir, &out.report.picture_spots)
-            .with_context(|| format!("{}: cannot write the pictures", dir.display()))?;
+        api::write_pictures(dir, &out)?;
     }
     if !quiet {
         print_out(&out.report.to_string());
@@ -296,53 +222,9 @@ fn yplus(args: &YplusArgs) -> Result<ExitCode> {
     Ok(ExitCode::SUCCESS)
 }
 
-/// The config file (if any) with the command-line flags on top, validated.
-fn mesh_config(args: &MeshArgs) -> Result<Config> {
-    let mut config = match &args.config {
-        Some(path) => Config::from_toml_file(path)?,
-        None => Config::default(),
-    };
-    let flags = &mut config.layers;
-    flags.first_height = args.first_height.or(flags.first_height);
-    flags.growth = args.growth.or(flags.growth);
-    if args.layers.is_some() || args.thickness.is_some() {
-        flags.count = args.layers;
-        flags.thickness = args.thickness;
-    }
-    config.feature_angle = args.feature_angle.or(config.feature_angle);
-    config.fan_angle = args.fan_angle.or(config.fan_angle);
-    config.peel_rounds = args.peel_rounds.or(config.peel_rounds);
-    if args.no_adapt {
-        config.sizing.adapt = Some(false);
-    }
-    if args.no_transition {
-        // The flag overrides the file's patch rules too.
-        config.layers.transition = Some(false);
-        config.patches.iter_mut().for_each(|p| p.layers.transition = Some(false));
-    }
-    config.validate()?;
-    Ok(config)
-}
-
 /// Print to stdout; a closed pipe (`blmesh info x | head`) is not an error worth a panic.
 fn print_out(text: &str) {
     use std::io::Write;
     let mut out = std::io::stdout().lock();
     let _ = writeln!(out, "{text}").and_then(|()| out.flush());
-}
-
-#[cfg(test)]
-mod tests {
-    use super::*;
-
-    /// A cause that the message above already quotes is not repeated; a new one is added.
-    #[test]
-    fn error_message_names_each_cause_once() {
-        let read = crate::io::read_surface(Path::new("/nonexistent/x.stl")).unwrap_err();
-        let quoted = read.to_string();
-        let e = anyhow::Error::new(read);
-        assert_eq!(error_message(&e), quoted);
-        let e = e.context("meshing failed");
-        assert_eq!(error_message(&e), format!("meshing failed: {quoted}"));
-    }
 }

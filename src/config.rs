@@ -273,12 +273,19 @@ impl Config {
 
     /// Parse a config; `yplus` keys are resolved into `first_height` with `[flow_conditions]`.
     pub fn from_toml_str(text: &str) -> Result<Config, String> {
-        let mut table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
-        if !resolve_yplus(&mut table).map_err(|e| e.to_string())? {
+        let table: toml::Table = toml::from_str(text).map_err(|e| e.to_string())?;
+        if !has_yplus(&table) {
             // Deserializing the text itself keeps line numbers in the errors.
             return toml::from_str(text).map_err(|e| e.to_string());
         }
-        table.try_into().map_err(|e: toml::de::Error| e.to_string())
+        Self::from_table(table)
+    }
+
+    /// A config given as a table of the TOML file's keys (the Python package's `config=` dict,
+    /// which arrives as JSON).
+    pub fn from_table(mut table: toml::Table) -> Result<Config, String> {
+        resolve_yplus(&mut table).map_err(|e| e.to_string())?;
+        table.try_into().map_err(|e: toml::de::Error| e.to_string().trim_end().to_owned())
     }
 
     pub fn feature_angle(&self) -> f64 {
@@ -350,9 +357,17 @@ impl Config {
     }
 }
 
+/// Whether the config uses `yplus` (or gives `[flow_conditions]` for it).
+fn has_yplus(table: &toml::Table) -> bool {
+    let in_table = |v: &toml::Value| v.as_table().is_some_and(|t| t.contains_key("yplus"));
+    table.contains_key("flow_conditions")
+        || table.get("layers").is_some_and(in_table)
+        || table.get("patch").and_then(toml::Value::as_array).is_some_and(|a| a.iter().any(in_table))
+}
+
 /// Replace every `yplus` (in `[layers]` and `[[patch]]`) by the `first_height` it gives at the
-/// `[flow_conditions]`, and remove that table; false when the config has neither.
-fn resolve_yplus(table: &mut toml::Table) -> Result<bool, ConfigError> {
+/// `[flow_conditions]`, and remove that table.
+fn resolve_yplus(table: &mut toml::Table) -> Result<(), ConfigError> {
     let flow = match table.remove("flow_conditions") {
         Some(value) => Some(
             FlowConditions::deserialize(value)
@@ -360,27 +375,26 @@ fn resolve_yplus(table: &mut toml::Table) -> Result<bool, ConfigError> {
         ),
         None => None,
     };
-    let mut found = flow.is_some();
     if let Some(toml::Value::Table(layers)) = table.get_mut("layers") {
-        found |= resolve_yplus_in("layers", layers, flow.as_ref())?;
+        resolve_yplus_in("layers", layers, flow.as_ref())?;
     }
     if let Some(toml::Value::Array(patches)) = table.get_mut("patch") {
         for (i, patch) in patches.iter_mut().enumerate() {
             if let toml::Value::Table(patch) = patch {
-                found |= resolve_yplus_in(&format!("patch[{i}]"), patch, flow.as_ref())?;
+                resolve_yplus_in(&format!("patch[{i}]"), patch, flow.as_ref())?;
             }
         }
     }
-    Ok(found)
+    Ok(())
 }
 
-/// Replace `yplus` in one layer-settings table (`what` names it in errors); false when absent.
+/// Replace `yplus` in one layer-settings table (`what` names it in errors), if it is there.
 fn resolve_yplus_in(
     what: &str,
     layers: &mut toml::Table,
     flow: Option<&FlowConditions>,
-) -> Result<bool, ConfigError> {
-    let Some(yplus) = layers.remove("yplus") else { return Ok(false) };
+) -> Result<(), ConfigError> {
+    let Some(yplus) = layers.remove("yplus") else { return Ok(()) };
     let name = format!("{what}.yplus");
     let yplus = yplus.as_float().or(yplus.as_integer().map(|i| i as f64));
     let yplus = yplus.ok_or_else(|| bad(&name, "(not a number)", "must be a number"))?;
@@ -390,7 +404,7 @@ fn resolve_yplus_in(
     let flow = flow.ok_or_else(|| bad(&name, yplus, "needs a [flow_conditions] table"))?;
     let height = flow.first_height(yplus)?.height;
     layers.insert("first_height".into(), toml::Value::Float(height));
-    Ok(true)
+    Ok(())
 }
 
 fn validate_layer_settings(what: &str, s: &LayerSettings) -> Result<(), ConfigError> {

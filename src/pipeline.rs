@@ -1,4 +1,4 @@
-//! The `mesh` pipeline, stage by stage (DESIGN.md): validate, analyse features, normals,
+//! The `mesh` pipeline, stage by stage (docs/design.md): validate, analyse features, normals,
 //! layers, (core), check; with timings and the run's report.
 
 use serde::Serialize;
@@ -146,7 +146,8 @@ pub fn run(
 ) -> Result<MeshOutput, MeshError> {
     let mut timings = Timings::default();
     let mut warnings = Vec::new();
-    let validation = timings.time("validate", || validate(&mut surface, &ValidationOptions::default()))?;
+    let validation =
+        progress.stage(&mut timings, "validate", || validate(&mut surface, &ValidationOptions::default()))?;
     warnings.extend(validation.warnings.iter().cloned());
     if config.flow == Flow::Internal {
         // Layers grow into the fluid, which is inside the surface: face the normals inward.
@@ -175,12 +176,12 @@ pub fn run(
         );
         patch_spec.iter_mut().flatten().for_each(|s| *s = s.without_transition());
     }
-    let (topology, features) = timings.time("features", || {
+    let (topology, features) = progress.stage(&mut timings, "features", || {
         let topology = Topology::new(&surface);
         let features = Features::compute(&surface, &topology, config.feature_angle());
         (topology, features)
     });
-    let wall_normals = timings.time("normals", || {
+    let wall_normals = progress.stage(&mut timings, "normals", || {
         let fan_angle = config.fan_angle();
         let mut n =
             normals::wall_normals_of_layered(&surface, &topology, &features, fan_angle, &layered_patch);
@@ -188,7 +189,7 @@ pub fn run(
         n
     });
     let sizing = match config.sizing.field_spec(&LayerSpec::resolve(&config.layers, body_size)?, body_size) {
-        Some(spec) => Some(timings.time("sizing", || SizingField::new(&surface, &spec))?),
+        Some(spec) => Some(progress.stage(&mut timings, "sizing", || SizingField::new(&surface, &spec))?),
         None => None,
     };
     let adapt = match (&sizing, config.sizing.adapt()) {
@@ -215,7 +216,7 @@ pub fn run(
     }
     warnings.extend(peel.failed_round.clone());
     let layer_summary = layer_summary(&layered, &surface, &topology, &features);
-    let check = timings.time("check", || quality::check(&mesh));
+    let check = progress.stage(&mut timings, "check", || quality::check(&mesh));
     if !check.is_valid() {
         return Err(MeshError::InvalidResult(Box::new(check)));
     }
@@ -327,8 +328,8 @@ impl LayersAndCore<'_> {
     /// March with the stacks at most `caps` layers high (by wall vertex) and fill the core.
     fn round(&self, caps: &[u32], timings: &mut Timings) -> Result<Round, MeshError> {
         let surface = self.surface;
-        let bar = self.progress.bar(0, "layers");
-        let (mut layered, core_wall) = timings.time("layers", || {
+        let bar = self.progress.bar("layers");
+        let (mut layered, core_wall) = self.progress.stage(timings, "layers", || {
             let mut layered = layers::build_layers(
                 surface,
                 self.topology,
@@ -336,10 +337,7 @@ impl LayersAndCore<'_> {
                 self.patch_spec,
                 self.adapt,
                 caps,
-                |k, n| {
-                    bar.set_length(n as u64);
-                    bar.set_position(k as u64);
-                },
+                |k, n| bar.set(k.into(), n.into()),
             );
             let core_wall = layers::sliding::close_sliding_patches(
                 &mut layered.mesh,
@@ -349,7 +347,7 @@ impl LayersAndCore<'_> {
             );
             (layered, core_wall)
         });
-        bar.finish_and_clear();
+        bar.finish();
         let closed = core_wall?;
         let symmetry = match closed.symmetry.as_slice() {
             [] => None,
@@ -368,7 +366,7 @@ impl LayersAndCore<'_> {
             return Ok(Round { layered, mesh, core: None, slivers: SliverScore::default() });
         }
         let growth = self.patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);
-        let (mesh, mut stats) = timings.time("core", || {
+        let (mesh, mut stats) = self.progress.stage(timings, "core", || {
             let mut options = CoreOptions::from_config(self.config);
             options.improve.size_band = growth;
             fill_core_on_symmetry_plane(&layered.mesh, &closed.core_wall, &options, symmetry)

@@ -1,35 +1,90 @@
-//! Progress bars (on a terminal only) and stage timings.
+//! Progress bars (on a terminal only), progress reported to a caller, and stage timings.
 
 use std::io::IsTerminal;
+use std::sync::Arc;
 use std::time::Instant;
 
 use indicatif::{ProgressBar, ProgressStyle};
 use serde::Serialize;
 
-/// Hands out progress bars: visible on a terminal unless quiet, hidden otherwise.
-#[derive(Clone, Copy, Debug)]
+/// Told the stage and the fraction of it done (0 at its start, 1 at its end).
+pub type Observer = Arc<dyn Fn(&str, f64) + Send + Sync>;
+
+/// Hands out progress bars (visible on a terminal unless quiet, hidden otherwise) and tells an
+/// observer, if any, how far each stage is: the Python package's callback.
+#[derive(Clone, Default)]
 pub struct Progress {
     visible: bool,
+    observer: Option<Observer>,
+}
+
+impl std::fmt::Debug for Progress {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Progress {{ visible: {}, observed: {} }}", self.visible, self.observer.is_some())
+    }
 }
 
 impl Progress {
     pub fn new(quiet: bool) -> Self {
-        Progress { visible: !quiet && std::io::stderr().is_terminal() }
+        Progress { visible: !quiet && std::io::stderr().is_terminal(), observer: None }
     }
 
     pub fn hidden() -> Self {
-        Progress { visible: false }
+        Progress::default()
     }
 
-    /// A bar counting `len` steps of work named `what`.
-    pub fn bar(&self, len: u64, what: &str) -> ProgressBar {
-        if !self.visible {
-            return ProgressBar::hidden();
+    /// No bar; every stage and step reported to `observer`.
+    pub fn observed(observer: Observer) -> Self {
+        Progress { visible: false, observer: Some(observer) }
+    }
+
+    fn tell(&self, stage: &str, fraction: f64) {
+        if let Some(observer) = &self.observer {
+            observer(stage, fraction);
         }
-        let style = ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} {elapsed}")
-            .unwrap_or_else(|_| ProgressStyle::default_bar())
-            .progress_chars("=> ");
-        ProgressBar::new(len).with_style(style).with_message(what.to_owned())
+    }
+
+    /// Run `f` as stage `name`, timed in `timings`, and tell the observer its start and end.
+    pub fn stage<T>(&self, timings: &mut Timings, name: &str, f: impl FnOnce() -> T) -> T {
+        self.tell(name, 0.0);
+        let out = timings.time(name, f);
+        self.tell(name, 1.0);
+        out
+    }
+
+    /// A bar counting the steps of stage `what`, as many as the last [`Bar::set`] says.
+    pub fn bar(&self, what: &str) -> Bar<'_> {
+        let bar = if self.visible {
+            let style = ProgressStyle::with_template("{msg:>12} [{bar:40}] {pos}/{len} {elapsed}")
+                .unwrap_or_else(|_| ProgressStyle::default_bar())
+                .progress_chars("=> ");
+            ProgressBar::new(0).with_style(style).with_message(what.to_owned())
+        } else {
+            ProgressBar::hidden()
+        };
+        Bar { bar, progress: self, what: what.to_owned() }
+    }
+}
+
+/// A progress bar on a terminal and the observer's steps of one stage.
+pub struct Bar<'a> {
+    bar: ProgressBar,
+    progress: &'a Progress,
+    what: String,
+}
+
+impl Bar<'_> {
+    /// `done` of `total` steps.
+    pub fn set(&self, done: u64, total: u64) {
+        self.bar.set_length(total);
+        self.bar.set_position(done);
+        if total > 0 {
+            self.progress.tell(&self.what, (done as f64 / total as f64).min(1.0));
+        }
+    }
+
+    pub fn finish(self) {
+        self.bar.finish_and_clear();
     }
 }
 

@@ -11,6 +11,10 @@ use blmesh::pipeline::{run, MeshOptions, MeshOutput};
 use blmesh::progress::Progress;
 use blmesh::surface::{shapes, Surface};
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 fn mesh(surface: &Surface, toml: &str) -> MeshOutput {
     let config = Config::from_toml_str(toml).expect("a valid config");
     let out = run(surface.clone(), &config, &MeshOptions { core: false }, Progress::hidden())
@@ -20,10 +24,7 @@ fn mesh(surface: &Surface, toml: &str) -> MeshOutput {
 }
 
 fn fandisk() -> Surface {
-    blmesh::io::read_surface(
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/fandisk.obj").as_ref(),
-    )
-    .expect("fandisk reads")
+    blmesh::io::read_surface(&shared_geometry("fandisk.obj")).expect("fandisk reads")
 }
 
 /// A coarse sphere (wall edges 0.14 to 0.16 of the radius), 12 layers from h0 = 0.005 (0.2

@@ -12,7 +12,11 @@ use blmesh::progress::Progress;
 use blmesh::quality;
 use blmesh::surface::{shapes, Surface};
 
-const ELBOW: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/elbow_90degree_cfmesh.stl");
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
+const ELBOW: &str = "elbow_90degree_cfmesh.stl";
 
 fn mesh(surface: &Surface, config: &str, core: bool) -> MeshOutput {
     let config = Config::from_toml_str(config).expect("a valid config");
@@ -50,7 +54,7 @@ fn off_plane(mesh: &VolumeMesh, nodes: &[u32], axis: usize, value: f64) -> f64 {
 
 #[test]
 fn elbow_internal_flow_has_layers_on_the_walls_and_planar_inlet_and_outlet() {
-    let surface = read_surface(std::path::Path::new(ELBOW)).expect("the elbow reads");
+    let surface = read_surface(&shared_geometry(ELBOW)).expect("the elbow reads");
     let size = surface.bounding_box().diagonal();
     let config = "flow = \"internal\"\n[layers]\ncount = 5\n\
                   [[patch]]\nmatch = \"inlet.*\"\nrole = \"inlet\"\n\
@@ -145,13 +149,13 @@ fn a_box_on_a_symmetry_plane_meshes_in_a_half_box() {
     assert!(patch_quads(m, "zmin") >= 8 * 4 * 4);
 }
 
-const ONERA_M6: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/onera_m6_gmsh_coarse.stl");
+const ONERA_M6: &str = "onera_m6_gmsh_coarse.stl";
 
 /// The ONERA M6 half wing on its symmetry plane (root face `face9`, y = 0), 25 layers from
-/// y+ = 1 at Re = 14.6e6 on the mean aerodynamic chord (mm): the issue's set-up.
+/// y+ = 1 at Re = 14.6e6 on the mean aerodynamic chord (mm): the usual ONERA M6 set-up.
 #[test]
 fn onera_m6_half_wing_on_its_symmetry_plane() {
-    let surface = read_surface(std::path::Path::new(ONERA_M6)).expect("the wing reads");
+    let surface = read_surface(&shared_geometry(ONERA_M6)).expect("the wing reads");
     let span = surface.bounding_box().max.y - surface.bounding_box().min.y;
     let config = "[layers]\nyplus = 1.0\ncount = 25\ngrowth = 1.2\n\
                   [flow_conditions]\nreynolds = 14.6e6\nlength = 646.07\n\
@@ -191,7 +195,7 @@ fn input_patch_border_edges(s: &Surface, name: &str) -> usize {
 #[test]
 #[ignore = "known bug: thick stacks cross on the ONERA M6 root plane"]
 fn onera_m6_half_wing_with_layers_to_isotropy() {
-    let surface = read_surface(std::path::Path::new(ONERA_M6)).expect("the wing reads");
+    let surface = read_surface(&shared_geometry(ONERA_M6)).expect("the wing reads");
     let config = "[layers]\nyplus = 1.0\ncount = \"auto\"\ngrowth = 1.2\n\
                   [flow_conditions]\nreynolds = 14.6e6\nlength = 646.07\n\
                   [[patch]]\nmatch = \"face9\"\nrole = \"symmetry\"\n";
@@ -205,7 +209,7 @@ fn onera_m6_half_wing_with_layers_to_isotropy() {
 /// self-intersecting; it is an interior face, and the mesh is whole and valid.
 #[test]
 fn a_front_closing_on_itself_is_no_boundary_for_the_core() {
-    let surface = read_surface(std::path::Path::new(ELBOW)).expect("the elbow reads");
+    let surface = read_surface(&shared_geometry(ELBOW)).expect("the elbow reads");
     let h0 = 2e-3 * surface.bounding_box().diagonal();
     let out = mesh(&surface, &format!("[layers]\ncount = 5\nfirst_height = {h0}\ngrowth = 1.15\n"), true);
     assert!(out.report.core.is_some(), "a core");

@@ -18,6 +18,10 @@ use blmesh::quality::{self, measures, validity};
 
 mod common;
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 const TRI_3: i32 = 5;
 const QUAD_4: i32 = 7;
 const MIXED: i32 = 20;
@@ -217,9 +221,11 @@ fn cli_writes_the_config_roles() {
     let config = dir.path().join("roles.toml");
     std::fs::write(&config, "[[patch]]\nmatch = \"prescribed\"\nrole = \"inlet\"\n").unwrap();
     let output = dir.path().join("cut.cgns");
-    let input = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/cutcube_cfmesh.stl");
+    let input = shared_geometry("cutcube_cfmesh.stl");
     let status = Command::new(env!("CARGO_BIN_EXE_blmesh"))
-        .args(["mesh", input, "--quiet", "--config"])
+        .arg("mesh")
+        .arg(&input)
+        .args(["--quiet", "--config"])
         .arg(&config)
         .arg("-o")
         .arg(&output)

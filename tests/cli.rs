@@ -9,6 +9,10 @@ use blmesh::io::{write_volume_mesh, MeshFormat};
 use blmesh::mesh::{CellKind, VolumeMesh};
 use blmesh::quality::samples::hybrid_column;
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 fn blmesh(args: &[&str]) -> Output {
     Command::new(env!("CARGO_BIN_EXE_blmesh")).args(args).output().expect("blmesh runs")
 }
@@ -28,7 +32,7 @@ fn assert_fails_with(o: &Output, words: &[&str]) {
 }
 
 fn geometry(name: &str) -> String {
-    format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"))
+    shared_geometry(name).display().to_string()
 }
 
 /// A unit cube as OBJ text, with `edit` applied to its 12 faces first.

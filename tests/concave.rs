@@ -10,6 +10,10 @@ use blmesh::pipeline::{run, MeshOptions, MeshOutput};
 use blmesh::progress::Progress;
 use blmesh::surface::{shapes, Surface};
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 /// `layers` layers growing by 1.2 from `h0`; returns the output and the total thickness.
 fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
     let config = Config {
@@ -28,10 +32,9 @@ fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
     (out, h0 * (1.2f64.powi(layers as i32) - 1.0) / 0.2)
 }
 
-/// Issue 7's spec on a shared geometry: 10 layers from 1e-3 of its diagonal.
+/// The concave-ridge set-up on a shared geometry: 10 layers from 1e-3 of its diagonal.
 fn mesh_shared(name: &str) -> MeshOutput {
-    let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
-    let surface = blmesh::io::read_surface(path.as_ref()).expect("reads");
+    let surface = blmesh::io::read_surface(&shared_geometry(name)).expect("reads");
     let h0 = 1e-3 * surface.bounding_box().diagonal();
     mesh(&surface, h0, 10).0
 }
@@ -156,7 +159,7 @@ fn thin_gaps_stop_at_the_medial_surface() {
     assert!(l.full_coverage >= 0.85, "full stacks (or gap-limited) at {:.3} of the wall", l.full_coverage);
 }
 
-/// The cut cube, fandisk, the flange and the arrow with the concave-ridge spec (10 layers from 1e-3 of
+/// The cut cube, fandisk, the flange and the arrow with the concave-ridge set-up (10 layers from 1e-3 of
 /// the diagonal): concave ridges that meet saddles, thin wall triangles along them, a 1 mm
 /// bore, fins on a body with blunt edges. Full stacks (or limited by a thin gap) within two
 /// thicknesses of a concave ridge, without transition layers: the cut cube 100% (its 4 such

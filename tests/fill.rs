@@ -19,6 +19,10 @@ use blmesh::quality;
 use blmesh::sizing::Region;
 use blmesh::surface::{shapes, Surface};
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 /// `count` layers, h0 = 1e-4 of the bounding-box diagonal, r = 1.2 (as tests/layers.rs).
 fn config(surface: &Surface, count: u32) -> Config {
     let h0 = 1e-4 * surface.bounding_box().diagonal();
@@ -140,7 +144,7 @@ fn sphere_with_layers() {
     let layers = layered(&wall, &config(&wall, 20));
     let stats = fill_and_check("sphere", &layers, &wall, &CoreOptions::default(), external_volume(&wall));
     assert_eq!(stats.pyramids, 0, "a smooth sphere has no fans, so no quads");
-    // The core quality bar, reached by our improvement (TetGen alone: 6.6 degrees).
+    // The core quality bar (no tetrahedron below 10 degrees), reached by our improvement (TetGen alone: 6.6 degrees).
     assert!(stats.min_dihedral >= 10.0, "sphere: core min dihedral {:.2}", stats.min_dihedral);
     assert_eq!(stats.quality.slivers.count, 0);
 }
@@ -173,7 +177,7 @@ fn core_edge_growth(mesh: &VolumeMesh, front_edge: f64, thickness: f64) -> f64 {
     percentile_90(edges.map(|(a, b)| a.distance(b) / (front_edge + 0.2 * distance(a, b))).collect())
 }
 
-/// DESIGN.md step 7: the core's sizes grow from the front's by the gradation (1.2: edges 0.2
+/// The core's sizes grow from the front's by the gradation (1.2: edges 0.2
 /// longer per unit length), not as fast as the distance (the mesher's own interpolation).
 #[test]
 fn the_core_sizes_grow_by_the_gradation() {
@@ -303,8 +307,7 @@ fn internal_flow_in_a_box() {
 }
 
 fn spot() -> Surface {
-    let path = Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/spot.obj"));
-    blmesh::io::read_surface(path).unwrap_or_else(|e| panic!("{e}"))
+    blmesh::io::read_surface(&shared_geometry("spot.obj")).unwrap_or_else(|e| panic!("{e}"))
 }
 
 /// Spot with 10 layers. (With 20 the layers' front crosses itself in concave places until the
@@ -355,7 +358,7 @@ fn worst_core_tetrahedra() {
         }
     }
     let name = std::env::var("BLMESH_SURFACE").unwrap_or_else(|_| "spot.obj".into());
-    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("../shared/geometries").join(&name);
+    let path = shared::shared_dir().join("geometries").join(&name);
     let (wall, cfg) = match name.as_str() {
         "box" => {
             let wall = shapes::cuboid(DVec3::new(2.0, 1.0, 1.5), 4);
@@ -425,7 +428,7 @@ fn auto_layers_on_a_sphere_end_without_a_size_jump() {
     assert!((0.9..1.15).contains(&jump.median), "median {}", jump.median);
 }
 
-/// Issue 5's bars with the defaults (h0 = 1e-3 D, 10 layers and transition layers to isotropy)
+/// The core's bars with the defaults (h0 = 1e-3 D, 10 layers and transition layers to isotropy)
 /// on the shipped examples: the first core tetrahedron on a front triangle is within [1/r, r]
 /// of the last layer under it (over every front triangle that is a top of the layers, see
 /// `size_jump::LastLayer`) at 95% of them (sphere 100.0%, box 97.7% measured), and the core has
@@ -452,15 +455,14 @@ fn default_meshes_of_the_examples_have_no_size_jump_at_the_layer_top() {
 
 /// The whole mesh of shared surface `name` with the defaults, through the checker.
 fn default_mesh_of_shared(name: &str) -> blmesh::pipeline::MeshOutput {
-    let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
-    let surface = blmesh::io::read_surface(Path::new(&path)).expect("the surface reads");
+    let surface = blmesh::io::read_surface(&shared_geometry(name)).expect("the surface reads");
     let out = run(surface, &Config::default(), &MeshOptions { core: true }, Progress::hidden())
         .expect("the surface meshes");
     assert!(out.report.check.is_valid(), "{name}: {}", out.report.check);
     out
 }
 
-/// Issue 5's bars on `fandisk.obj` with the defaults: 95% of the front triangles' first core
+/// The core's bars on `fandisk.obj` with the defaults: 95% of the front triangles' first core
 /// tetrahedra within [1/r, r] of the last layer (97.8% measured; 99.1% of those on prisms), and
 /// no core dihedral angle below 10 degrees (10.01 measured; 10.01 and 10.006 at growth 1.1999
 /// and 1.2001). The last slivers (4.35 degrees) were in the needle two fans left crossing at
@@ -482,7 +484,7 @@ fn fandisk_default_mesh_has_no_size_jump_at_the_layer_top() {
     assert!(on_prisms >= 0.95, "{:.1}% within [1/r, r] on prisms", 100.0 * on_prisms);
 }
 
-/// Issue 5's bars on `spot.obj` and the arrow with the defaults: 95% of the first core
+/// The core's bars on `spot.obj` and the arrow with the defaults: 95% of the first core
 /// tetrahedra within [1/r, r] of the last layer (96.5% and 98.8% measured, since insertions grow
 /// their cavity across faces that would make slivers), and no core dihedral angle below 10
 /// degrees (10.01 and 10.01 measured; 10.00 at growth 1.1999 and 1.2001 on both). Spot's
@@ -512,8 +514,8 @@ fn spot_and_arrow_default_meshes_have_no_size_jump_at_the_layer_top() {
 /// and nothing where the core has no sliver to mend; without rounds its slivers stay.
 #[test]
 fn peeling_mends_spot_for_a_few_stacks_and_can_be_turned_off() {
-    let path = format!("{}/../shared/geometries/spot.obj", env!("CARGO_MANIFEST_DIR"));
-    let surface = || blmesh::io::read_surface(Path::new(&path)).expect("the surface reads");
+    let path = shared_geometry("spot.obj");
+    let surface = || blmesh::io::read_surface(&path).expect("the surface reads");
     let unpeeled = Config { peel_rounds: Some(0), ..Config::default() };
     let plain = run(surface(), &unpeeled, &MeshOptions { core: true }, Progress::hidden()).expect("meshes");
     assert!(plain.report.check.is_valid());
@@ -529,7 +531,7 @@ fn peeling_mends_spot_for_a_few_stacks_and_can_be_turned_off() {
     assert!(after.march.columns_stopped_at_caps > 0);
 }
 
-/// Issue 5 on the ONERA M6 half wing meshed whole (`face9` a wall), with the defaults: the
+/// The core on the ONERA M6 half wing meshed whole (`face9` a wall), with the defaults: the
 /// wing tip's blunt trailing edge and cap are faceted at 0.2-0.4 under a first layer of 1.675
 /// (H = 1e-3 D), and 49 of its wall vertices got no layer. Those stacks' first height is now
 /// fitted to the wall ([layers] first_aspect, graded around) and the layers marched again:

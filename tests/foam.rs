@@ -12,8 +12,12 @@ use std::process::Command;
 
 use openfoam::CheckMesh;
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 fn geometry(name: &str) -> String {
-    format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"))
+    shared_geometry(name).display().to_string()
 }
 
 /// A case `name` in a fresh directory meshed from `surface` by the blmesh binary (with the

@@ -13,10 +13,14 @@ use blmesh::pipeline::{run, MeshOptions, MeshOutput};
 use blmesh::progress::Progress;
 use blmesh::surface::{shapes, Surface};
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 const LAYERS: u32 = 20;
 const GROWTH: f64 = 1.2;
 
-/// 20 layers, h0 = 1e-4 of the bounding-box diagonal, r = 1.2 (the issue's set-up).
+/// 20 layers, h0 = 1e-4 of the bounding-box diagonal, r = 1.2 (the layer benchmark's set-up).
 fn mesh_layers(surface: &Surface) -> (MeshOutput, f64) {
     let h0 = 1e-4 * surface.bounding_box().diagonal();
     let config = Config {
@@ -119,13 +123,12 @@ fn sphere_gets_all_layers_on_the_exact_offset() {
 }
 
 /// Real organic surfaces (mild concavity): the layers are valid and conforming everywhere;
-/// columns may stop early near concave folds where the entropy collapse does not hold, so
+/// columns may stop early near concave folds where the entropy collapse does not reach, so
 /// the coverage is reported, and most of the wall must get the full stack.
 #[test]
 fn spot_and_bunny_layers_are_valid() {
     for (name, min_coverage) in [("spot.obj", 0.8), ("bunny_closed_herholz.off", 0.8)] {
-        let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
-        let surface = blmesh::io::read_surface(std::path::Path::new(&path)).unwrap();
+        let surface = blmesh::io::read_surface(&shared_geometry(name)).unwrap();
         let (out, _) = mesh_layers(&surface);
         let r = &out.report;
         common::assert_valid_for_a_solver(name, &r.check);
@@ -224,10 +227,7 @@ fn transition_layers_carry_a_fixed_count_to_isotropy() {
 /// from the few columns that stop early).
 #[test]
 fn patch_settings_meet_without_steps() {
-    let surface = blmesh::io::read_surface(
-        concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/arrow_cape.stl").as_ref(),
-    )
-    .expect("the arrow reads");
+    let surface = blmesh::io::read_surface(&shared_geometry("arrow_cape.stl")).expect("the arrow reads");
     let config = Config::from_toml_str(
         "[layers]\nfirst_height = 0.01\ncount = 10\ntransition = false\n\
          [[patch]]\nmatch = \"fin.*\"\nfirst_height = 0.0025\n\

@@ -3,13 +3,16 @@
 //! volume; the UH3D and STL versions of the CAPE arrow are the same surface.
 
 use std::collections::BTreeSet;
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use blmesh::io::read_surface;
 use blmesh::surface::Surface;
 
+#[path = "common/shared.rs"]
+mod shared;
+
 fn geometry(name: &str) -> PathBuf {
-    Path::new(concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries")).join(name)
+    shared::shared_dir().join("geometries").join(name)
 }
 
 fn read(name: &str) -> Surface {

@@ -1,7 +1,6 @@
 //! The sizing field on a real surface: exact wall distance on the bunny, sizes that follow the
 //! layer law, and (ignored, run with `--release -- --ignored --nocapture`) evaluation speed.
 
-use std::path::Path;
 use std::time::Instant;
 
 use blmesh::geometry::distance::closest_point_on_triangle;
@@ -10,10 +9,12 @@ use blmesh::sizing::{SizingField, SizingSpec};
 use blmesh::surface::Surface;
 use rayon::prelude::*;
 
-const BUNNY: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries/bunny_closed_herholz.off");
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
 
 fn bunny() -> Surface {
-    blmesh::io::read_surface(Path::new(BUNNY)).expect("the bunny reads")
+    blmesh::io::read_surface(&shared_geometry("bunny_closed_herholz.off")).expect("the bunny reads")
 }
 
 /// Deterministic pseudo-random points in the bounding box grown by `margin` on every side.

@@ -22,6 +22,10 @@ use blmesh::progress::Progress;
 
 mod common;
 
+#[path = "common/shared.rs"]
+mod shared;
+use shared::shared_geometry;
+
 /// Faces of the UGRID tetrahedron, pyramid (apex 2), prism and hexahedron, normals into the cell.
 const INWARD_FACES: [&[&[usize]]; 4] = [
     &[&[1, 3, 2], &[0, 2, 3], &[0, 3, 1], &[0, 1, 2]],
@@ -266,7 +270,7 @@ fn check_run(name: &str, surface: &Path, config: &str, core: bool, ugrid: &str) 
 }
 
 fn shared(name: &str) -> String {
-    format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"))
+    shared_geometry(name).display().to_string()
 }
 
 /// The ONERA M6 half wing on its symmetry plane (root `face9`, y = 0), 5 layers, with a core.

@@ -3,7 +3,7 @@
 //! Every file there is a valid wall (closed, manifold, oriented outward, no self-intersection).
 //! `every_geometry_is_valid` prints a summary table (run with `--nocapture` to see it).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::time::Instant;
 
 use blmesh::io::{read_surface, SurfaceFormat};
@@ -12,10 +12,15 @@ use blmesh::surface::topology::Topology;
 use blmesh::surface::validate::{validate, ValidationOptions, ValidationReport};
 use blmesh::surface::Surface;
 
-const GEOMETRIES: &str = concat!(env!("CARGO_MANIFEST_DIR"), "/../shared/geometries");
+#[path = "common/shared.rs"]
+mod shared;
+
+fn geometries() -> PathBuf {
+    shared::shared_dir().join("geometries")
+}
 
 fn read(name: &str) -> Surface {
-    let path = Path::new(GEOMETRIES).join(name);
+    let path = geometries().join(name);
     read_surface(&path).unwrap_or_else(|e| panic!("{e}"))
 }
 
@@ -38,8 +43,9 @@ fn is_internal_flow(name: &str) -> bool {
 }
 
 fn surface_files() -> Vec<PathBuf> {
-    let mut files: Vec<PathBuf> = std::fs::read_dir(GEOMETRIES)
-        .unwrap_or_else(|e| panic!("{GEOMETRIES}: {e}"))
+    let dir = geometries();
+    let mut files: Vec<PathBuf> = std::fs::read_dir(&dir)
+        .unwrap_or_else(|e| panic!("{}: {e}", dir.display()))
         .map(|entry| entry.unwrap().path())
         .filter(|path| SurfaceFormat::from_path(path).is_some())
         .collect();

@@ -1,4 +1,4 @@
-//! The core's sizes away from the front (DESIGN.md step 7): they grow from the front's (and
+//! The core's sizes away from the front (docs/design.md, the core): they grow from the front's (and
 //! the farfield's) by the gradation, edges at most `gradation - 1` longer per unit length, stay
 //! under the user's maximum size and shrink to the user's refinement regions (`[sizing]`).
 //!

@@ -1,4 +1,4 @@
-//! Core fill (DESIGN.md step 7): isotropic tetrahedra between the final layer front and the
+//! Core fill (docs/design.md): isotropic tetrahedra between the final layer front and the
 //! farfield, merged with the layers into one conforming hybrid mesh.
 //!
 //! [`fill_core`] gathers the core's boundary from the layered mesh ([`front`]): the top faces

@@ -7,7 +7,7 @@
 //! column stopped (`t = b`), two columns merged (`t_i = t_i+1`) or two fan copies share a wall
 //! node (`b_i = b_i+1`), and vanishes when two of these happen. Every face depends only on its own
 //! nodes, so the two cells sharing a face always agree on it: the slab is conforming by
-//! construction (DESIGN.md, "Staying conforming").
+//! construction.
 //!
 //! A column that merged into another this slab (a collapse: its top is the survivor's top) makes
 //! the lateral quads beside it twisted: their top edge runs towards the survivor, away from the

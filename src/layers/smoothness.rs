@@ -1,4 +1,4 @@
-//! How smoothly the layers end and grow (the smoothness report): neighbouring wall
+//! How smoothly the layers end and grow (the report's smoothness): neighbouring wall
 //! vertices should end at similar thicknesses, consecutive layers should grow by at most the
 //! growth ratio, and a stack ended at isotropy should end with a last layer about as high as the
 //! front is wide there.

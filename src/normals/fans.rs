@@ -667,8 +667,7 @@ mod closed_front_tests {
             "flange.stl",
             "arrow_cape.stl",
         ] {
-            let path = format!("{}/../shared/geometries/{name}", env!("CARGO_MANIFEST_DIR"));
-            let s = crate::io::read_surface(std::path::Path::new(&path)).unwrap();
+            let s = crate::io::read_surface(&crate::test_shared::shared_geometry(name)).unwrap();
             let topo = Topology::new(&s);
             let features = Features::compute(&s, &topo, 30.0);
             let normals = wall_normals(&s, &topo, &features, 20.0);

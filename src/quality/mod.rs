@@ -1,6 +1,6 @@
 //! Volume-mesh checker: the oracle every test uses ([`check`]).
 //!
-//! It checks the invariants of `DESIGN.md`: every cell positive by exact orientation tests of two
+//! It checks the invariants of `docs/design.md`: every cell positive by exact orientation tests of two
 //! decompositions ([`validity`]), faces conforming and the boundary closed ([`conformity`]), the
 //! cell volumes adding up to the volume enclosed by the boundary, and it measures the quality of
 //! the cells with the definitions of `shared/bench/measure.py` ([`measures`]).

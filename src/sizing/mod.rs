@@ -1,4 +1,4 @@
-//! The sizing field (DESIGN.md step 5): a metric `M(x) = Q diag(h_n^-2, h_t^-2, h_t^-2) Q^T`
+//! The sizing field (docs/design.md): a metric `M(x) = Q diag(h_n^-2, h_t^-2, h_t^-2) Q^T`
 //! defined everywhere, from the wall (normal size growing like the geometric layers, tangential
 //! size from the wall's edge lengths graded away from it) intersected with the user's isotropic
 //! sizing (maximum size, refinement regions graded from their boundary).

@@ -1,4 +1,4 @@
-//! Feature analysis (DESIGN.md step 3): the signed dihedral turn of every edge, ridge edges,
+//! Feature analysis: the signed dihedral turn of every edge, ridge edges,
 //! ridge lines, and the kind of every vertex (smooth, ridge, corner).
 //!
 //! Convention: the right-hand normals of the surface point INTO the fluid. After validation that

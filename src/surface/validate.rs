@@ -1,4 +1,4 @@
-//! Validation of an input wall surface (DESIGN.md step 2).
+//! Validation of an input wall surface.
 //!
 //! [`validate`] checks, in this order: vertex indices, finite coordinates, degenerate triangles,
 //! duplicate triangles, open edges, non-manifold edges, non-manifold vertices, consistent

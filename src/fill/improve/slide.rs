@@ -7,7 +7,7 @@
 //! (where columns merged and no prism is under it, along the front's normal by the step of
 //! the columns around it) lifts it out of that plane. The last layer gets shorter by at most
 //! [`MAX_SINK`] of its step, no more than keeps it within the growth ratio of the layer under
-//! it (DESIGN.md, smoothness), and the stack loses at most [`MAX_THINNING`] of its thickness.
+//! it (smoothness), and the stack loses at most [`MAX_THINNING`] of its thickness.
 //! A pyramid's apex on a front quad moves too, its height kept in the size band. Every cell
 //! outside the core at the point (the layer cells and the pyramids on the front's quads) must
 //! stay valid by the checker's exact test, and the tetrahedra at it positive: the point stays
