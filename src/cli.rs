@@ -140,6 +140,8 @@ struct MeshArgs {
 
 /// Run the command line; returns the process exit code.
 pub fn main() -> ExitCode {
+    // Before any thread starts (see the module).
+    crate::interrupt::install();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -240,6 +242,7 @@ fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
     if let Some(why) = format.unavailable() {
         bail!("{}: {why}", args.output.display());
     }
+    check_outputs_writable(args, format)?;
     let config = mesh_config(args)?;
     let surface = io::read_surface(&args.input)?;
     let options = MeshOptions { core: !args.no_core };
@@ -260,6 +263,21 @@ fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
         print_out(&out.report.to_string());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Every output can be written: fail before the meshing, not after it.
+fn check_outputs_writable(args: &MeshArgs, format: MeshFormat) -> Result<()> {
+    let pictures = args.pictures.as_ref().map(|dir| (dir.join("overview.png"), true));
+    let outputs = [
+        Some((args.output.clone(), format == MeshFormat::Foam)),
+        args.report.clone().map(|r| (r, false)),
+        pictures,
+    ];
+    for (path, created_dirs) in outputs.into_iter().flatten() {
+        io::check_writable(&path, created_dirs)
+            .with_context(|| format!("{}: cannot write", path.display()))?;
+    }
+    Ok(())
 }
 
 fn yplus(args: &YplusArgs) -> Result<ExitCode> {

@@ -157,6 +157,7 @@ pub fn run(
         format!("[[patch]] match = {pattern:?} matches no patch (it must match a whole name)")
     }));
     let mut patch_spec = patch_layer_specs(&surface, config, body_size)?;
+    check_first_heights(&surface, &patch_spec, body_size)?;
     let layered_patch: Vec<bool> = patch_spec.iter().map(Option::is_some).collect();
     let symmetry_patch: Vec<bool> =
         surface.patch_names.iter().map(|name| config.patch_settings(name).0 == Role::Symmetry).collect();
@@ -504,6 +505,25 @@ fn patch_layer_specs(
             Ok(Some(LayerSpec::resolve(&settings, body_size)?))
         })
         .collect()
+}
+
+/// A first layer height that makes no sense at the body's scale or position
+/// ([`crate::limits::first_height_problem`]) is an error naming the patch.
+fn check_first_heights(
+    surface: &Surface,
+    specs: &[Option<LayerSpec>],
+    body_size: f64,
+) -> Result<(), ConfigError> {
+    let bounds = surface.bounding_box();
+    let largest = bounds.min.abs().max(bounds.max.abs()).max_element();
+    for (name, spec) in surface.patch_names.iter().zip(specs) {
+        let Some(h) = spec.map(|s| s.first_height) else { continue };
+        if let Some(why) = crate::limits::first_height_problem(h, body_size, largest) {
+            let name = format!("first_height (patch {name})");
+            return Err(ConfigError::Parameter { name, value: h.to_string(), why });
+        }
+    }
+    Ok(())
 }
 
 /// A warning for every patch without layers that is not planar: columns cannot slide on it,
