@@ -38,12 +38,7 @@ fn main() -> std::process::ExitCode {
     let start = std::time::Instant::now();
     let campaign = blmesh::fuzz::campaign(&binary, seed, cases, &files, dir.path(), &limits, threads)
         .expect("the campaign runs");
-    let record = exe
-        .parent()
-        .and_then(Path::parent)
-        .and_then(Path::parent)
-        .unwrap()
-        .join(format!("fuzz-campaign-{seed}.tsv"));
+    let record = root.join("target").join(format!("fuzz-campaign-{seed}.tsv"));
     std::fs::write(&record, campaign.table()).expect("the record is written");
     println!("{} in {:.0} s", campaign.summary(cases), start.elapsed().as_secs_f64());
     println!("record: {}", record.display());

@@ -10,7 +10,7 @@ use std::path::Path;
 use blmesh::fuzz::run::{Limits, Verdict};
 
 /// Cases of the CI run, and the campaign seed they come from.
-const CASES: u64 = 240;
+const CASES: u64 = 400;
 const SEED: u64 = 1;
 
 /// The small shipped surfaces that are mutated besides the shapes built in code.

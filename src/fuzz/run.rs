@@ -46,6 +46,8 @@ pub enum Verdict {
     Rejected,
     /// Exit 1 or 2 whose message names no place in the input.
     RejectedUnlocated,
+    /// The mesh was made but failed its own check: not a crash, but a finding.
+    SelfCheckFailed,
     Panic,
     OutOfMemory,
     Timeout,
@@ -56,7 +58,10 @@ pub enum Verdict {
 impl Verdict {
     /// Whether the run is a failure of blmesh (not of its input).
     pub fn is_failure(self) -> bool {
-        !matches!(self, Verdict::Accepted | Verdict::Rejected | Verdict::RejectedUnlocated)
+        !matches!(
+            self,
+            Verdict::Accepted | Verdict::Rejected | Verdict::RejectedUnlocated | Verdict::SelfCheckFailed
+        )
     }
 }
 
@@ -91,6 +96,7 @@ impl Outcome {
             Exit::Timeout => Verdict::Timeout,
             _ if self.stderr.contains("panicked") => Verdict::Panic,
             Exit::Code(0) => Verdict::Accepted,
+            Exit::Code(1) if self.stderr.contains("failed its own check") => Verdict::SelfCheckFailed,
             Exit::Code(1 | 2) if self.names_a_place() => Verdict::Rejected,
             Exit::Code(1 | 2) => Verdict::RejectedUnlocated,
             Exit::Code(101) => Verdict::Panic,
@@ -188,6 +194,8 @@ mod tests {
         assert_eq!(outcome(Exit::Code(0), "").verdict(&l), Verdict::Accepted);
         assert_eq!(outcome(Exit::Code(1), "error: x.obj: line 3: bad").verdict(&l), Verdict::Rejected);
         assert_eq!(outcome(Exit::Code(1), "error: failed").verdict(&l), Verdict::RejectedUnlocated);
+        let check = "error: the mesh failed its own check (a bug in blmesh; please report it):\ntriangle";
+        assert_eq!(outcome(Exit::Code(1), check).verdict(&l), Verdict::SelfCheckFailed);
         let panic = "thread 'main' panicked at src/x.rs:1:1:\ncapacity overflow";
         assert_eq!(outcome(Exit::Code(101), panic).verdict(&l), Verdict::Panic);
         assert_eq!(
