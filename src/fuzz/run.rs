@@ -84,7 +84,7 @@ const PLACES: [&str; 16] = [
     "no triangles",
     "too short",
     "directory",
-    "the file ",
+    "the file",
 ];
 
 impl Outcome {
