@@ -108,6 +108,8 @@ struct MeshArgs {
 
 /// Run the command line; returns the process exit code.
 pub fn main() -> ExitCode {
+    // Before any thread starts (see the module).
+    crate::interrupt::install();
     let cli = match Cli::try_parse() {
         Ok(cli) => cli,
         Err(e) => {
@@ -169,6 +171,7 @@ fn check(path: &Path, json: bool) -> Result<ExitCode> {
 
 fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
     let format = api::output_format(&args.output, args.ascii)?;
+    check_outputs_writable(args, format)?;
     let config = match &args.config {
         Some(path) => Config::from_toml_file(path)?,
         None => Config::default(),
@@ -186,6 +189,21 @@ fn mesh(args: &MeshArgs, quiet: bool, progress: Progress) -> Result<ExitCode> {
         print_out(&out.report.to_string());
     }
     Ok(ExitCode::SUCCESS)
+}
+
+/// Every output can be written: fail before the meshing, not after it.
+fn check_outputs_writable(args: &MeshArgs, format: crate::io::MeshFormat) -> Result<()> {
+    let pictures = args.pictures.as_ref().map(|dir| (dir.join("overview.png"), true));
+    let outputs = [
+        Some((args.output.clone(), format == crate::io::MeshFormat::Foam)),
+        args.report.clone().map(|r| (r, false)),
+        pictures,
+    ];
+    for (path, created_dirs) in outputs.into_iter().flatten() {
+        crate::io::check_writable(&path, created_dirs)
+            .map_err(|e| anyhow::anyhow!("{}: cannot write: {e}", path.display()))?;
+    }
+    Ok(())
 }
 
 fn yplus(args: &YplusArgs) -> Result<ExitCode> {

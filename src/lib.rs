@@ -14,9 +14,13 @@ pub mod api;
 pub mod cli;
 pub mod config;
 pub mod fill;
+#[cfg(unix)]
+pub mod fuzz;
 pub mod geometry;
+pub mod interrupt;
 pub mod io;
 pub mod layers;
+pub mod limits;
 pub mod mesh;
 pub mod normals;
 pub mod picture;

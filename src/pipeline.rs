@@ -6,6 +6,7 @@ use serde::Serialize;
 use crate::config::{Config, ConfigError, Flow, LayerSpec, Role};
 use crate::fill::improve::{min_dihedral, SLIVER_THRESHOLD};
 use crate::fill::{fill_core_on_symmetry_plane, CoreOptions, CoreStats, FillError};
+use crate::geometry::DVec3;
 use crate::layers::sliding::SlidingError;
 use crate::layers::{self, Adapt, MarchStats};
 use crate::mesh::{CellKind, VolumeMesh};
@@ -16,7 +17,7 @@ use crate::quality::{self, CheckReport};
 use crate::sizing::SizingField;
 use crate::surface::features::{FeatureCounts, Features, VertexKind};
 use crate::surface::topology::Topology;
-use crate::surface::validate::{validate, ValidationError, ValidationOptions};
+use crate::surface::validate::{format_point, validate, ValidationError, ValidationOptions};
 use crate::surface::Surface;
 
 /// Options of a run that are not meshing parameters.
@@ -41,6 +42,12 @@ pub enum MeshError {
     Sliding(#[from] SlidingError),
     #[error(transparent)]
     Sizing(#[from] crate::sizing::SpecError),
+    #[error(
+        "no cell was made: the columns of {stopped} wall vertices stopped before their first layer, \
+         e.g. at {examples}; a first layer far thinner than the wall's triangles are wide may need \
+         a finer wall"
+    )]
+    NoCells { stopped: usize, examples: String },
     #[error("the mesh failed its own check (a bug in blmesh; please report it):\n{0}")]
     InvalidResult(Box<CheckReport>),
 }
@@ -126,6 +133,10 @@ pub struct CellCounts {
 }
 
 impl CellCounts {
+    fn total(&self) -> usize {
+        self.tetrahedra + self.pyramids + self.prisms + self.hexahedra
+    }
+
     fn of(mesh: &VolumeMesh) -> Self {
         CellCounts {
             tetrahedra: mesh.block(CellKind::Tetrahedron).len(),
@@ -158,6 +169,7 @@ pub fn run(
         format!("[[patch]] match = {pattern:?} matches no patch (it must match a whole name)")
     }));
     let mut patch_spec = patch_layer_specs(&surface, config, body_size)?;
+    check_first_heights(&surface, &patch_spec, body_size)?;
     let layered_patch: Vec<bool> = patch_spec.iter().map(Option::is_some).collect();
     let symmetry_patch: Vec<bool> =
         surface.patch_names.iter().map(|name| config.patch_settings(name).0 == Role::Symmetry).collect();
@@ -216,6 +228,11 @@ pub fn run(
     }
     warnings.extend(peel.failed_round.clone());
     let layer_summary = layer_summary(&layered, &surface, &topology, &features);
+    if CellCounts::of(&mesh).total() == 0 {
+        let examples = layer_summary.stopped_examples.iter().take(3).map(|&p| format_point(DVec3::from(p)));
+        let examples = examples.collect::<Vec<_>>().join(", ");
+        return Err(MeshError::NoCells { stopped: layer_summary.stopped_vertices, examples });
+    }
     let check = progress.stage(&mut timings, "check", || quality::check(&mesh));
     if !check.is_valid() {
         return Err(MeshError::InvalidResult(Box::new(check)));
@@ -506,6 +523,25 @@ fn patch_layer_specs(
             Ok(Some(LayerSpec::resolve(&settings, body_size)?))
         })
         .collect()
+}
+
+/// A first layer height that makes no sense at the body's scale or position
+/// ([`crate::limits::first_height_problem`]) is an error naming the patch.
+fn check_first_heights(
+    surface: &Surface,
+    specs: &[Option<LayerSpec>],
+    body_size: f64,
+) -> Result<(), ConfigError> {
+    let bounds = surface.bounding_box();
+    let largest = bounds.min.abs().max(bounds.max.abs()).max_element();
+    for (name, spec) in surface.patch_names.iter().zip(specs) {
+        let Some(h) = spec.map(|s| s.first_height) else { continue };
+        if let Some(why) = crate::limits::first_height_problem(h, body_size, largest) {
+            let name = format!("first_height (patch {name})");
+            return Err(ConfigError::Parameter { name, value: h.to_string(), why });
+        }
+    }
+    Ok(())
 }
 
 /// A warning for every patch without layers that is not planar: columns cannot slide on it,

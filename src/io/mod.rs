@@ -14,9 +14,12 @@ pub mod off;
 mod scan;
 pub mod stl;
 pub mod su2;
+mod temporaries;
 pub mod ugrid;
 pub mod uh3d;
 pub mod vtu;
+
+pub(crate) use temporaries::remove_all_and_hold as remove_temporaries_and_hold;
 
 use std::fmt;
 use std::io::Write;
@@ -263,23 +266,26 @@ pub fn write_atomic_via_path(
 pub fn write_dir_atomic(path: &Path, fill: impl FnOnce(&Path) -> std::io::Result<()>) -> std::io::Result<()> {
     let parent = parent_dir(path);
     std::fs::create_dir_all(parent)?;
-    let tmp = temporary_builder(0o777).tempdir_in(parent)?;
+    let (registration, tmp) =
+        temporaries::create(|| temporary_builder(0o777).tempdir_in(parent), |d| d.path())?;
     fill(tmp.path())?;
-    let aside = temporary_builder(0o700).tempdir_in(parent)?;
-    let old = aside.path().join("old");
-    let had_old = match std::fs::rename(path, &old) {
-        Ok(()) => true,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
-        Err(e) => return Err(e),
-    };
-    if let Err(e) = std::fs::rename(tmp.path(), path) {
-        if had_old {
-            std::fs::rename(&old, path)?;
+    registration.finish(|| {
+        let aside = temporary_builder(0o700).tempdir_in(parent)?;
+        let old = aside.path().join("old");
+        let had_old = match std::fs::rename(path, &old) {
+            Ok(()) => true,
+            Err(e) if e.kind() == std::io::ErrorKind::NotFound => false,
+            Err(e) => return Err(e),
+        };
+        if let Err(e) = std::fs::rename(tmp.path(), path) {
+            if had_old {
+                std::fs::rename(&old, path)?;
+            }
+            return Err(e);
         }
-        return Err(e);
-    }
-    let _ = tmp.keep();
-    Ok(())
+        let _ = tmp.keep();
+        Ok(())
+    })
 }
 
 /// Write one file of a directory being built by [`write_dir_atomic`], synced to disk.
@@ -318,11 +324,34 @@ fn replace_through_temporary(
     path: &Path,
     fill: impl FnOnce(&mut tempfile::NamedTempFile) -> std::io::Result<()>,
 ) -> std::io::Result<()> {
-    let mut tmp = temporary_builder(0o666).tempfile_in(parent_dir(path))?;
+    let (registration, mut tmp) =
+        temporaries::create(|| temporary_builder(0o666).tempfile_in(parent_dir(path)), |f| f.path())?;
     fill(&mut tmp)?;
     tmp.as_file().sync_all()?;
-    tmp.persist(path).map_err(|e| e.error)?;
+    registration.finish(|| tmp.persist(path).map_err(|e| e.error))?;
     Ok(())
+}
+
+/// Fail now, before minutes of work, when `path` could not be written later: its directory
+/// must exist and take a new file. With `created_dirs`, missing directories above `path` are
+/// made when writing, so the nearest one that exists must take them.
+pub fn check_writable(path: &Path, created_dirs: bool) -> std::io::Result<()> {
+    let mut dir = parent_dir(path);
+    if created_dirs {
+        while !dir.exists() {
+            dir = parent_dir(dir);
+        }
+    }
+    let problem = |why: &str| std::io::Error::other(format!("directory {} {why}", dir.display()));
+    match std::fs::metadata(dir) {
+        Ok(meta) if meta.is_dir() => {}
+        Ok(_) => return Err(problem("is not a directory")),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Err(problem("does not exist")),
+        Err(e) => return Err(problem(&format!("cannot be read: {e}"))),
+    }
+    // Permission bits do not tell (root, read-only mounts, ACLs): try.
+    let probe = temporaries::create(|| temporary_builder(0o600).tempfile_in(dir), |f| f.path());
+    probe.map(drop).map_err(|e| problem(&format!("is not writable: {e}")))
 }
 
 #[cfg(test)]

@@ -12,6 +12,9 @@ use super::topology::{find, opposite_vertex, union, Topology};
 use super::Surface;
 use crate::geometry::DVec3;
 
+/// How many cells the ridges of [`Features::near_concave_ridges`] span at most, in all.
+const MAX_RIDGE_SAMPLES: usize = 1 << 20;
+
 /// The default feature angle: an edge whose normals turn by more than this is a ridge.
 pub const DEFAULT_FEATURE_ANGLE_DEG: f64 = 30.0;
 
@@ -117,12 +120,19 @@ impl Features {
         if ridges.is_empty() || !(reach > 0.0 && reach.is_finite()) {
             return vec![false; radius.len()];
         }
-        let cell = |p: DVec3| (p / reach).floor().as_i64vec3().to_array();
+        // Cells of at least the reach, and coarse enough that the ridges give at most about
+        // 2 MAX_RIDGE_SAMPLES samples whatever the scale of the reach.
+        let length: f64 = ridges.iter().map(|[a, b]| a.distance(*b)).sum();
+        let size = reach.max(length / MAX_RIDGE_SAMPLES as f64);
+        if !size.is_finite() {
+            return vec![false; radius.len()];
+        }
+        let cell = |p: DVec3| (p / size).floor().as_i64vec3().to_array();
         let mut grid: std::collections::HashMap<[i64; 3], Vec<u32>> = std::collections::HashMap::new();
         for (i, &[a, b]) in ridges.iter().enumerate() {
             // Samples at most half a cell apart: the closest point of the segment to a vertex
             // within reach is within half a cell of one, so within two cells of the vertex's.
-            let samples = ((a.distance(b) / (0.5 * reach)).ceil() as usize).max(1);
+            let samples = ((a.distance(b) / (0.5 * size)).ceil() as usize).max(1);
             let mut cells: Vec<[i64; 3]> =
                 (0..=samples).map(|k| cell(a.lerp(b, k as f64 / samples as f64))).collect();
             cells.dedup();

@@ -1,6 +1,7 @@
 //! Validation of an input wall surface.
 //!
-//! [`validate`] checks, in this order: vertex indices, finite coordinates, degenerate triangles,
+//! [`validate`] checks, in this order: vertex indices, coordinates (finite, in the accepted range of
+//! [`crate::limits`]), degenerate triangles,
 //! duplicate triangles, open edges, non-manifold edges, non-manifold vertices, consistent
 //! orientation, self-intersections; then it measures every shell (connected component) and
 //! flips the shells that enclose negative volume, so that every shell's normals point out of
@@ -106,7 +107,15 @@ pub enum ValidationError {
         count(.examples.total, "triangle"))]
     VertexIndexOutOfRange { vertex_count: usize, examples: Examples<TriangleCorners> },
     #[error("non-finite coordinates (NaN or infinity) at {}, {examples}", count(.examples.total, "vertex"))]
-    NonFiniteCoordinates { examples: Examples<VertexAt> },
+    NonFiniteCoordinates { examples: Examples<CoordinateAt> },
+    #[error("coordinates beyond the accepted range (|x| <= {:e}) at {}, {examples}; rescale or move \
+        the surface", crate::limits::MAX_COORDINATE, count(.examples.total, "vertex"))]
+    CoordinatesOutOfRange { examples: Examples<CoordinateAt> },
+    #[error("body too small for where it is: its bounding box from {} to {} has a diagonal of {}, \
+        below {:e} of its largest coordinate magnitude {} (or of 1); rescale or move the surface",
+        format_point(.bounds.min), format_point(.bounds.max), format_coordinate(*.size),
+        crate::limits::MIN_BODY_RATIO, format_coordinate(*.largest))]
+    BodyTooSmall { bounds: Aabb, size: f64, largest: f64 },
     #[error("{} with zero area (a repeated vertex or three exactly collinear vertices), {examples}",
         count(.examples.total, "degenerate triangle"))]
     DegenerateTriangles { examples: Examples<TriangleAt> },
@@ -172,6 +181,22 @@ pub struct VertexAt {
 impl fmt::Display for VertexAt {
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
         write!(f, "vertex {} at {}", self.vertex, format_point(self.point))
+    }
+}
+
+/// A vertex and the first triangle that uses it (none: the vertex is unused).
+#[derive(Clone, Debug, PartialEq)]
+pub struct CoordinateAt {
+    pub vertex: VertexAt,
+    pub triangle: Option<TriangleTag>,
+}
+
+impl fmt::Display for CoordinateAt {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match &self.triangle {
+            Some(t) => write!(f, "{} of {t}", self.vertex),
+            None => write!(f, "{} (used by no triangle)", self.vertex),
+        }
     }
 }
 
@@ -332,15 +357,37 @@ impl Describe<'_> {
         let corners = |t: u32| TriangleCorners { triangle: self.tag(t), vertices: s.triangles[t as usize] };
         let error = |examples| ValidationError::VertexIndexOutOfRange { vertex_count, examples };
         self.reject(&out_of_range, corners, error)?;
-        let non_finite = filter_ids(s.points.len(), |v| !s.points[v as usize].is_finite());
-        let error = |examples| ValidationError::NonFiniteCoordinates { examples };
-        self.reject(&non_finite, |v| self.vertex(v), error)?;
+        self.check_coordinates()?;
         let degenerate = filter_ids(s.triangles.len(), |t| is_degenerate(s, t as usize));
         let error = |examples| ValidationError::DegenerateTriangles { examples };
         self.reject(&degenerate, |t| self.triangle(t), error)?;
         let duplicates = duplicate_triangles(&s.triangles);
         let error = |examples| ValidationError::DuplicateTriangles { examples };
         self.reject(&duplicates, |(a, b)| self.pair(a, b), error)?;
+        Ok(())
+    }
+
+    /// Finite, within [`crate::limits::MAX_COORDINATE`], and a body not too small for where it
+    /// is ([`crate::limits::smallest_body`]): later stages size their work from coordinates.
+    fn check_coordinates(&self) -> Result<(), ValidationError> {
+        let s = self.surface;
+        let first_use = first_triangle_of_vertices(s);
+        let at = |v: u32| CoordinateAt {
+            vertex: self.vertex(v),
+            triangle: first_use.get(v as usize).copied().flatten().map(|t| self.tag(t)),
+        };
+        let non_finite = filter_ids(s.points.len(), |v| !s.points[v as usize].is_finite());
+        let error = |examples| ValidationError::NonFiniteCoordinates { examples };
+        self.reject(&non_finite, at, error)?;
+        let in_range = |p: DVec3| p.to_array().into_iter().all(crate::limits::coordinate_in_range);
+        let far = filter_ids(s.points.len(), |v| !in_range(s.points[v as usize]));
+        let error = |examples| ValidationError::CoordinatesOutOfRange { examples };
+        self.reject(&far, at, error)?;
+        let bounds = s.bounding_box();
+        let (size, largest) = (bounds.diagonal(), bounds.min.abs().max(bounds.max.abs()).max_element());
+        if size < crate::limits::smallest_body(largest) {
+            return Err(ValidationError::BodyTooSmall { bounds, size, largest });
+        }
         Ok(())
     }
 
@@ -439,6 +486,17 @@ impl Describe<'_> {
 pub(crate) fn patch_name(surface: &Surface, t: usize) -> &str {
     let patch = surface.triangle_patch.get(t).and_then(|&p| surface.patch_names.get(p as usize));
     patch.map_or("", String::as_str)
+}
+
+/// The first triangle of every vertex (triangle indices must be in range).
+fn first_triangle_of_vertices(s: &Surface) -> Vec<Option<u32>> {
+    let mut first = vec![None; s.points.len()];
+    for (t, tri) in s.triangles.iter().enumerate().rev() {
+        for &v in tri {
+            first[v as usize] = Some(t as u32);
+        }
+    }
+    first
 }
 
 fn filter_ids(n: usize, bad: impl Fn(u32) -> bool) -> Vec<u32> {
@@ -915,6 +973,40 @@ mod tests {
         assert!(matches!(e, ValidationError::NonFiniteCoordinates { .. }));
         assert!(e.to_string().contains("at 1 vertex, e.g. vertex 3 at ("), "{e}");
         assert!(e.to_string().contains("NaN"), "{e}");
+    }
+
+    #[test]
+    fn coordinates_beyond_the_range_name_the_vertex_triangle_and_value() {
+        let mut s = cube();
+        s.points[3].x = 1e19;
+        let e = check(&mut s).unwrap_err();
+        assert!(matches!(e, ValidationError::CoordinatesOutOfRange { .. }), "{e}");
+        let t = s.triangles.iter().position(|t| t.contains(&3)).unwrap();
+        let text = e.to_string();
+        assert!(text.contains(&format!("vertex 3 at (1.000000e19, ")), "{text}");
+        assert!(text.contains(&format!("of triangle {t}")), "{text}");
+        let mut s = cube();
+        s.points.push(DVec3::new(0.0, -2e12, 0.0));
+        let text = check(&mut s).unwrap_err().to_string();
+        assert!(text.contains("vertex 8 at (0, -2.000000e12, 0) (used by no triangle)"), "{text}");
+    }
+
+    #[test]
+    fn a_body_too_small_for_where_it_is_is_rejected() {
+        for (scale, offset, ok) in
+            [(1e-11, 0.0, true), (1e-13, 0.0, false), (1e-3, 1e9, true), (1e-3, 1e10, false)]
+        {
+            let mut s = cube();
+            s.points.iter_mut().for_each(|p| *p = *p * scale + DVec3::splat(offset));
+            let r = check(&mut s);
+            if ok {
+                r.unwrap();
+            } else {
+                let e = r.unwrap_err();
+                assert!(matches!(e, ValidationError::BodyTooSmall { .. }), "{e}");
+                assert!(e.to_string().contains("bounding box from ("), "{e}");
+            }
+        }
     }
 
     #[test]

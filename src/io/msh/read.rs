@@ -132,7 +132,7 @@ pub fn read(bytes: &[u8]) -> Result<RawMesh, ParseError> {
         c.expect(&format!("$End{name}"))?;
     }
     if version.is_none() {
-        return Err(ParseError::file("no $MeshFormat section: not an MSH file"));
+        return Err(ParseError::file("no $MeshFormat section in the file: not an MSH file"));
     }
     Ok(mesh)
 }

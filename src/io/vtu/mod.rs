@@ -72,7 +72,8 @@ fn required<'f, 'a>(
     name: Option<&str>,
     what: &str,
 ) -> Result<&'f Array<'a>, ParseError> {
-    file.find(section, name).ok_or_else(|| ParseError::file(format!("no {what} DataArray")))
+    file.find(section, name)
+        .ok_or_else(|| ParseError::file(format!("no {what} DataArray in the file's {section:?} section")))
 }
 
 fn read_points(file: &VtuFile) -> Result<Vec<DVec3>, ParseError> {
