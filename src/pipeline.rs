@@ -222,9 +222,13 @@ pub fn run(
         progress: &progress,
     };
     let (Round { layered, mut mesh, core, .. }, peel) = stages.run_peeling(&mut timings)?;
-    let unused = mesh.drop_unused_points();
-    if unused > 0 {
-        tracing::info!(unused, "points used by no cell left out");
+    // A layers-only mesh keeps every wall point first (a core filled later starts from them,
+    // those of patches without layers too); a whole mesh leaves out what no cell uses.
+    if options.core {
+        let unused = mesh.drop_unused_points();
+        if unused > 0 {
+            tracing::info!(unused, "points used by no cell left out");
+        }
     }
     warnings.extend(peel.failed_round.clone());
     let layer_summary = layer_summary(&layered, &surface, &topology, &features);
