@@ -36,6 +36,8 @@ fn case(name: &str, surface: &str, extra: &[&str]) -> Option<(tempfile::TempDir,
 /// `case/report.json`) and add `system/`.
 fn mesh_case(case: &Path, surface: &str, extra: &[&str]) -> PathBuf {
     let poly = case.join("constant/polyMesh");
+    // The report's directory must exist before the meshing starts (the polyMesh's is made).
+    std::fs::create_dir_all(case).expect("the case directory");
     let out = Command::new(env!("CARGO_BIN_EXE_blmesh"))
         .args(["mesh", surface, "-o"])
         .arg(&poly)
