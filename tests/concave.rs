@@ -16,7 +16,15 @@ use shared::shared_geometry;
 
 /// `layers` layers growing by 1.2 from `h0`; returns the output and the total thickness.
 fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
-    let config = Config {
+    let config = layered_config(h0, layers);
+    let out =
+        run(surface.clone(), &config, &MeshOptions { core: false }, Progress::hidden()).expect("meshes");
+    (out, h0 * (1.2f64.powi(layers as i32) - 1.0) / 0.2)
+}
+
+/// `layers` layers growing by 1.2 from `h0`, no transition layers.
+fn layered_config(h0: f64, layers: u32) -> Config {
+    Config {
         layers: LayerSettings {
             first_height: Some(h0),
             growth: Some(1.2),
@@ -26,10 +34,7 @@ fn mesh(surface: &Surface, h0: f64, layers: u32) -> (MeshOutput, f64) {
             first_aspect: None,
         },
         ..Default::default()
-    };
-    let out =
-        run(surface.clone(), &config, &MeshOptions { core: false }, Progress::hidden()).expect("meshes");
-    (out, h0 * (1.2f64.powi(layers as i32) - 1.0) / 0.2)
+    }
 }
 
 /// The concave-ridge set-up on a shared geometry: 10 layers from 1e-3 of its diagonal.
@@ -264,4 +269,38 @@ fn a_step_lower_than_the_layers_are_thick_keeps_every_layer() {
     assert_full_coverage("step", &out);
     let err = offset_error(&surface, &out, t);
     assert!(err < 0.02, "top front off the exact offset by {:.2}% of the thickness", 100.0 * err);
+}
+
+/// A slot narrower than two stacks: the fronts of its side walls meet head on at its medial
+/// plane. They stop a layer short of it, so the core between them is two layers high and not
+/// a slab of any thinness; those stacks count as gap-limited, and the core has no sliver.
+#[test]
+fn fronts_meeting_across_a_slot_leave_the_core_a_gap_it_can_fill() {
+    // A 3 x 1 x 2 block with a slot of width 1 and depth 1 across the middle of its top; 12
+    // layers from 0.02 are 0.79 thick, more than the slot's half-width.
+    let surface = shapes::voxels([3, 1, 2], 1.0, 4, |i, _, k| !(i == 1 && k == 1));
+    let (layered, _) = mesh(&surface, 0.02, 12);
+    let r = &layered.report;
+    common::assert_valid_for_a_solver("slot", &r.check);
+    assert!(r.layers.gap_limited_vertices >= 20, "{} gap-limited vertices", r.layers.gap_limited_vertices);
+    // Above the slot's bottom corners' bisectors (which are the columns' own: they merge on
+    // them), the slot's medial surface is the plane x = 1.5; the side walls' tops stay clear
+    // of it by more than a first layer.
+    let mesh = &layered.mesh;
+    let top = mesh.patch_names.iter().position(|n| n == TOP_PATCH).unwrap() as u32;
+    let b = &mesh.boundary;
+    let nodes = b.triangles.iter().zip(&b.triangle_patch).filter(|(_, &p)| p == top).flat_map(|(t, _)| *t);
+    let quads = b.quads.iter().zip(&b.quad_patch).filter(|(_, &p)| p == top).flat_map(|(q, _)| *q);
+    let closest = nodes
+        .chain(quads)
+        .map(|n| mesh.points[n as usize])
+        .filter(|p| p.z > 1.6 && p.z < 2.0 && p.x > 1.0 && p.x < 2.0)
+        .map(|p| (p.x - 1.5).abs())
+        .fold(f64::INFINITY, f64::min);
+    assert!(closest > 0.02, "a front in the slot within {closest:.4} of its medial plane");
+    let config = layered_config(0.02, 12);
+    let out = run(surface, &config, &MeshOptions { core: true }, Progress::hidden()).expect("meshes");
+    common::assert_valid_for_a_solver("slot with its core", &out.report.check);
+    let core = out.report.core.as_ref().expect("a core");
+    assert!(core.min_dihedral >= 10.0, "core minimum dihedral {:.2} deg", core.min_dihedral);
 }

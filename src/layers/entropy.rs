@@ -140,6 +140,12 @@ impl<'a> VertexWalls<'a> {
         triangles.iter().map(|&t| self.normals[t as usize])
     }
 
+    /// How much farther from the walls with layers the front can climb from `top`, up to
+    /// `reach` ([`super::gap::room_above`]).
+    pub fn room_above(&self, top: DVec3, heading: DVec3, reach: f64) -> f64 {
+        super::gap::room_above(self.layered.bvh(), top, heading, reach)
+    }
+
     /// Distance from `p` to the nearest wall with layers (infinite when there is none).
     pub fn distance(&self, p: DVec3) -> f64 {
         self.layered.closest(p).map_or(f64::INFINITY, |w| w.distance)

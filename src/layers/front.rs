@@ -33,6 +33,9 @@ pub struct Columns {
     pub isotropic_ratio: Vec<f64>,
     /// For those columns: the front's tangential size they ended at (NaN for the others).
     pub isotropic_size: Vec<f64>,
+    /// Stopped where its next layer would leave less than its own height below the medial
+    /// surface of the gap it faces (the march's gap stop): as thick as the gap allows.
+    pub ended_at_gap: Vec<bool>,
     /// Length of the column's last step (its last layer's height along it).
     pub last_step: Vec<f64>,
     /// The ratio of a step to the one before that is farthest from 1 (0 before two steps).
@@ -114,6 +117,7 @@ impl Columns {
         self.slide.push(start.slide);
         self.isotropic_ratio.push(f64::NAN);
         self.isotropic_size.push(f64::NAN);
+        self.ended_at_gap.push(false);
         self.last_step.push(start.last_step);
         self.max_step_ratio.push(0.0);
         self.spec.push(start.spec);

@@ -1,10 +1,11 @@
 //! Thin gaps: where the wall faces itself across less than two stack thicknesses, the fronts
-//! from the two sides meet at the medial surface between them, and the crossing guard ends
-//! their stacks there rather than let them cross. Such a stack is as thick as the gap allows,
-//! so it counts as reached: the medial surface is the bisector of the two walls.
+//! from the two sides meet at the medial surface between them. The march stops them a layer
+//! short of it, where the climb from their wall points stalls ([`room_above`]), and the
+//! crossing guard where they would cross all the same. Such a stack is as thick as the gap
+//! allows, so it counts as reached: the medial surface is the bisector of the two walls.
 //!
-//! A column that stopped early is gap-limited when the front above its top has no room for the
-//! layer it could not build: climbing the exact wall distance from the top (away from the
+//! A column the march stopped at a gap is gap-limited. Another that stopped early is
+//! gap-limited when the front above its top has no room for the layer it could not build: climbing the exact wall distance from the top (away from the
 //! nearest wall points, along a shock where two meet) gains less than that layer before the
 //! climb stalls at the medial surface of a gap (where two walls within [`FACING_ANGLE_DEG`] of
 //! facing each other meet: across a slot, at a slot's bottom corners and lips, in a narrow
@@ -52,7 +53,8 @@ pub fn gap_limited(
         .map(|c| {
             let v = columns.wall_vertex[c] as usize;
             let edges = wall_edges_at(surface, topology, v as u32);
-            (v, reaches_medial_surface(surface, &bvh, columns, points, c, &edges))
+            let planned = columns.ended_at_gap[columns.carrier(c)];
+            (v, planned || reaches_medial_surface(surface, &bvh, columns, points, c, &edges))
         })
         .collect();
     for (v, ok) in short {

@@ -65,6 +65,9 @@ pub struct MarchStats {
     /// Columns stopped a layer under where the core could not fill around their tops
     /// ([`stop_at_caps`]).
     pub columns_stopped_at_caps: usize,
+    /// Columns stopped to leave the core room below the medial surface of a gap
+    /// ([`stop_at_gaps`]).
+    pub columns_stopped_at_gaps: usize,
 }
 
 /// Node ids of the slab being built: committed nodes are `< committed`, a moving column `c`
@@ -426,6 +429,7 @@ pub fn march(
     let mut stats = MarchStats::default();
     let mut guard = CrossingGuard::default();
     let mut pit: Vec<Option<f64>> = vec![None; columns.len()];
+    let mut rooms: Vec<f64> = Vec::new();
     for k in 1..=max_layers {
         let _layer = tracing::debug_span!("layer", k).entered();
         for c in 0..columns.len() {
@@ -434,6 +438,8 @@ pub fn march(
             }
         }
         stats.columns_stopped_at_caps += stop_at_caps(columns, caps, &mut pit, k);
+        plan_gaps(columns, walls, &mut rooms);
+        stats.columns_stopped_at_gaps += stop_at_gaps(columns, &rooms, k);
         stats.columns_stopped_for_pits += grade_around_pits(columns, front, &mut pit, k);
         if (0..columns.len()).any(|c| columns.stops_when_isotropic(c, k)) {
             let wall_size = matches!(sizes.adapt, Adapt::Off).then_some(sizes.wall.as_slice());
@@ -902,6 +908,62 @@ fn stop_at_caps(columns: &mut Columns, caps: &[u32], pit: &mut Vec<Option<f64>>,
         if columns.alive[c] && capped {
             columns.alive[c] = false;
             *depth = Some(columns.distance(c, k - 1).unwrap_or(0.0));
+            stopped += 1;
+        }
+    }
+    stopped
+}
+
+/// The medial surface of the gap each new column faces (`rooms`, by column): how far its climb
+/// from its wall point along the exact wall distance gets before it stalls
+/// ([`super::gap::room_above`]). Infinite where it does not stall within twice the stack, and
+/// where it stalls within the first layer: that is the column's own corner (a concave ridge's
+/// bisector), where the entropy merges carry the stack on.
+fn plan_gaps(columns: &Columns, walls: &VertexWalls, rooms: &mut Vec<f64>) {
+    let start = rooms.len();
+    rooms.resize(columns.len(), f64::INFINITY);
+    let fresh: Vec<(usize, f64)> = (start..columns.len())
+        .into_par_iter()
+        .filter_map(|c| {
+            let full = columns.distance(c, columns.full_count(c)?)?;
+            let first = columns.distance(c, 1)?;
+            let reach = 2.0 * full;
+            let (base, dir) = (columns.base[c], columns.dir[c]);
+            // The wall point still nearest at `reach` along the column: the distance rises all
+            // the way there (it is 1-Lipschitz), so the climb would not stall.
+            if walls.distance(base + dir * reach) >= reach * (1.0 - 1e-9) {
+                return None;
+            }
+            let room = walls.room_above(base, dir, reach);
+            (room < reach && room > first).then_some((c, room))
+        })
+        .collect();
+    for (c, room) in fresh {
+        rooms[c] = room;
+    }
+}
+
+/// Stop, before layer `k`, the stacks of the wall vertices with a column whose layer would leave
+/// less than its own height between its top and the medial surface of its gap (`rooms`): the
+/// fronts meeting there from both sides leave the core a gap of two layers' height, where
+/// stopping at their crossing left slabs of any thinness, which only slivers fill. Returns how
+/// many columns stopped.
+fn stop_at_gaps(columns: &mut Columns, rooms: &[f64], k: u32) -> usize {
+    let mut vertex_ends = vec![false; columns.wall_vertex_count()];
+    for c in 0..columns.len() {
+        let close = match (columns.distance(c, k), columns.distance(c, k - 1)) {
+            (Some(d), Some(d_before)) => rooms[c] - d < d - d_before,
+            _ => false,
+        };
+        if columns.alive[c] && close {
+            vertex_ends[columns.wall_vertex[c] as usize] = true;
+        }
+    }
+    let mut stopped = 0;
+    for c in 0..columns.len() {
+        if columns.alive[c] && vertex_ends[columns.wall_vertex[c] as usize] {
+            columns.alive[c] = false;
+            columns.ended_at_gap[c] = true;
             stopped += 1;
         }
     }

@@ -30,6 +30,11 @@ impl WallDistance {
         WallDistance { bvh: TriangleBvh::new(corners), triangles: wall.triangles.clone() }
     }
 
+    /// The wall's triangles, for searches of their own.
+    pub fn bvh(&self) -> &TriangleBvh {
+        &self.bvh
+    }
+
     /// The closest wall point to `p` (`None` for an empty wall).
     pub fn closest(&self, p: DVec3) -> Option<WallPoint> {
         let near = self.bvh.nearest(p)?;
