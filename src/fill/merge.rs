@@ -7,6 +7,7 @@ use super::front::CoreBuild;
 use super::{sorted_triangle, ClosedBoundary, CoreGuide, CoreStats, CoreTets, FillError};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
+use crate::mesh::compact_points;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::{dihedral_range, edge_face_pairs};
 
@@ -120,20 +121,14 @@ pub(super) fn seeds_in_place_first(
 /// interior point it was given out of its mesh), renumbering the others.
 pub(super) fn drop_unused_points(core: &mut CoreTets, fixed: usize) {
     let mut used = vec![false; core.points.len()];
+    used[..fixed].fill(true);
     for &v in core.tets.iter().flatten() {
         used[v as usize] = true;
     }
-    if used[fixed..].iter().all(|&u| u) {
+    if used.iter().all(|&u| u) {
         return;
     }
-    let mut new_index = vec![u32::MAX; core.points.len()];
-    let mut points = Vec::with_capacity(core.points.len());
-    for (i, p) in core.points.iter().enumerate() {
-        if i < fixed || used[i] {
-            new_index[i] = points.len() as u32;
-            points.push(*p);
-        }
-    }
+    let (points, new_index) = compact_points(&core.points, &used);
     core.points = points;
     for t in &mut core.tets {
         *t = t.map(|v| new_index[v as usize]);

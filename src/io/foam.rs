@@ -14,7 +14,7 @@ use std::path::Path;
 
 use crate::config::Role;
 use crate::geometry::DVec3;
-use crate::mesh::{Across, FaceTable, VolumeMesh};
+use crate::mesh::{compact_points, Across, FaceTable, VolumeMesh};
 use crate::quality::fv::face_geometry;
 
 /// The last path component that makes an output a polyMesh directory.
@@ -116,20 +116,13 @@ fn write_points(w: &mut dyn Write, points: &[DVec3]) -> io::Result<()> {
 
 /// The points some face uses, and the new number of every old point (`u32::MAX` if left out).
 fn used_points(points: &[DVec3], table: &FaceTable) -> (Vec<DVec3>, Vec<u32>) {
-    let mut ids = vec![u32::MAX; points.len()];
+    let mut used = vec![false; points.len()];
     for f in 0..table.len() {
         for &n in table.nodes(f) {
-            ids[n as usize] = 0;
+            used[n as usize] = true;
         }
     }
-    let mut kept = Vec::with_capacity(points.len());
-    for (id, p) in ids.iter_mut().zip(points) {
-        if *id == 0 {
-            *id = kept.len() as u32;
-            kept.push(*p);
-        }
-    }
-    (kept, ids)
+    compact_points(points, &used)
 }
 
 fn write_faces(w: &mut dyn Write, table: &FaceTable, ids: &[u32]) -> io::Result<()> {

@@ -5,9 +5,9 @@
 //! allows, so it counts as reached: the medial surface is the bisector of the two walls.
 //!
 //! A column the march stopped at a gap is gap-limited. Another that stopped early is
-//! gap-limited when the front above its top has no room for the layer it could not build: climbing the exact wall distance from the top (away from the
-//! nearest wall points, along a shock where two meet) gains less than that layer before the
-//! climb stalls at the medial surface of a gap (where two walls within [`FACING_ANGLE_DEG`] of
+//! gap-limited when the front above its top has no room for the layer it could not build:
+//! climbing the exact wall distance from the top (away from the nearest wall points, along a
+//! shock where two meet) gains less than that layer before the climb stalls at the medial surface of a gap (where two walls within [`FACING_ANGLE_DEG`] of
 //! facing each other meet: across a slot, at a slot's bottom corners and lips, in a narrow
 //! wedge). Where the front closes on an axis, as in a bore, two layers. The fronts at a
 //! concave ridge of a wider angle go on along its bisector, so a stop there is never excused.
@@ -52,9 +52,12 @@ pub fn gap_limited(
         .filter(|&c| is_stopped[columns.wall_vertex[c] as usize] && stopped_early(columns, c))
         .map(|c| {
             let v = columns.wall_vertex[c] as usize;
-            let edges = wall_edges_at(surface, topology, v as u32);
             let planned = columns.ended_at_gap[columns.carrier(c)];
-            (v, planned || reaches_medial_surface(surface, &bvh, columns, points, c, &edges))
+            let limited = planned || {
+                let edges = wall_edges_at(surface, topology, v as u32);
+                reaches_medial_surface(surface, &bvh, columns, points, c, &edges)
+            };
+            (v, limited)
         })
         .collect();
     for (v, ok) in short {
@@ -120,8 +123,9 @@ const CLIMB_STEPS: f64 = 16.0;
 
 /// How much farther from the wall (up to `reach`) the front can get above `top`: climb the
 /// wall distance from `top` in steps of `reach / CLIMB_STEPS`, along `heading` (the column's
-/// direction: a top still on the wall has no other) or away from the nearest wall point, or where that step crosses a shock (another wall point becomes the nearest) along
-/// the shock, away from both; stop where no step gains `sin(FACING_ANGLE_DEG / 2)` of its
+/// direction: a top still on the wall has no other) or away from the nearest wall point, or,
+/// where that step crosses a shock (another wall point becomes the nearest), along the shock,
+/// away from both; stop where no step gains `sin(FACING_ANGLE_DEG / 2)` of its
 /// length. That is the rise along the bisector of two walls at [`FACING_ANGLE_DEG`]: between
 /// walls that face each other more, the climb stalls at their medial surface.
 pub fn room_above(bvh: &TriangleBvh, top: DVec3, mut heading: DVec3, reach: f64) -> f64 {

@@ -267,32 +267,38 @@ impl VolumeMesh {
     /// Leave out the points no cell uses (solvers and converters count them as errors) and
     /// renumber the rest in their order; returns how many went.
     pub fn drop_unused_points(&mut self) -> usize {
-        let mut new_id = vec![u32::MAX; self.points.len()];
+        let mut used = vec![false; self.points.len()];
         for b in &self.blocks {
             for &n in &b.nodes {
-                new_id[n as usize] = 0;
+                used[n as usize] = true;
             }
         }
-        let mut kept = 0u32;
-        for id in new_id.iter_mut().filter(|id| **id == 0) {
-            *id = kept;
-            kept += 1;
-        }
-        let dropped = self.points.len() - kept as usize;
+        let (points, new_id) = compact_points(&self.points, &used);
+        let dropped = self.points.len() - points.len();
         if dropped == 0 {
             return 0;
         }
-        let mut i = 0;
-        self.points.retain(|_| {
-            i += 1;
-            new_id[i - 1] != u32::MAX
-        });
+        self.points = points;
         let renumber = |n: &mut u32| *n = new_id[*n as usize];
         self.blocks.iter_mut().for_each(|b| b.nodes.iter_mut().for_each(renumber));
         let faces = &mut self.boundary;
         faces.triangles.iter_mut().flatten().chain(faces.quads.iter_mut().flatten()).for_each(renumber);
         dropped
     }
+}
+
+/// The points with `used[i]`, in their order, and the new number of every old point
+/// (`u32::MAX` for those left out).
+pub fn compact_points(points: &[DVec3], used: &[bool]) -> (Vec<DVec3>, Vec<u32>) {
+    let mut ids = vec![u32::MAX; points.len()];
+    let mut kept = Vec::with_capacity(points.len());
+    for (i, p) in points.iter().enumerate() {
+        if used[i] {
+            ids[i] = kept.len() as u32;
+            kept.push(*p);
+        }
+    }
+    (kept, ids)
 }
 
 #[cfg(test)]
