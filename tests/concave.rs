@@ -8,6 +8,7 @@ use blmesh::geometry::distance::closest_point_on_triangle;
 use blmesh::layers::TOP_PATCH;
 use blmesh::pipeline::{run, MeshOptions, MeshOutput};
 use blmesh::progress::Progress;
+use blmesh::surface::family::{family_body_at, Family};
 use blmesh::surface::{shapes, Surface};
 
 #[path = "common/shared.rs"]
@@ -303,4 +304,20 @@ fn fronts_meeting_across_a_slot_leave_the_core_a_gap_it_can_fill() {
     common::assert_valid_for_a_solver("slot with its core", &out.report.check);
     let core = out.report.core.as_ref().expect("a core");
     assert!(core.min_dihedral >= 10.0, "core minimum dihedral {:.2} deg", core.min_dihedral);
+}
+
+/// A groove of the randomised family (seed 2: 71 degrees, oblique to the block, one triangle
+/// from lip to bottom) at the families' spec: at layer 10 the walls' fronts have shrunk to a
+/// quarter of their width and the tangential collapses merged lip and bisector columns, which
+/// turned the lips' fans over one another and stopped 43 stacks. A collapse whose columns the
+/// slab then stops is taken back: coarsening is never worth a layer.
+#[test]
+fn tangential_collapses_never_cost_a_groove_its_layers() {
+    let surface = family_body_at(Family::Grooves, 2, 1.0);
+    let h0 = 1e-3 * surface.bounding_box().diagonal();
+    let mut config = layered_config(h0, 10);
+    config.layers.transition = None;
+    let out = run(surface, &config, &MeshOptions { core: false }, Progress::hidden()).expect("meshes");
+    assert!(out.report.layers.march.tangential_collapses > 0, "the groove's fronts must coarsen");
+    assert_full_coverage("family groove 2", &out);
 }

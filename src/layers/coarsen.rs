@@ -35,42 +35,47 @@ pub const CRUSHED_LENGTH: f64 = 0.05;
 
 /// What [`collapse_short_edges`] did.
 pub(super) struct Coarsening {
-    /// Edges collapsed.
-    pub made: usize,
+    /// The edges collapsed, as the pairs of columns `(a, b)`, `a < b`, that were their ends.
+    pub made: Vec<(u32, u32)>,
     /// The short edges left shorter than [`CRUSHED_LENGTH`], as root pairs.
     pub crushed: Vec<(u32, u32)>,
 }
 
 /// Collapse the plan's short front edges of layer `k` against the tangential sizes `h` at the
-/// columns' proposed tops (and the layer's height, within the user's sizes `user`);
-/// `cells_valid(plan, group)` tells whether every cell around the columns `group` is valid
-/// under the plan.
+/// columns' proposed tops (and the layer's height, within the user's sizes `user`), but not the
+/// edges `vetoed` (pairs `(a, b)`, `a < b`); `cells_valid(plan, group)` tells whether every cell
+/// around the columns `group` is valid under the plan.
 pub(super) fn collapse_short_edges(
     plan: &mut SlabPlan,
     front: &Front,
     columns: &Columns,
     (h, user, k): (&[f64], &[f64], u32),
+    vetoed: &[(u32, u32)],
     cells_valid: impl Fn(&SlabPlan, &[u32]) -> bool,
 ) -> Coarsening {
     let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
     let sizes = EdgeSizes { target: h, height: &height, user };
-    let mut made = 0;
+    let mut made = Vec::new();
     for _ in 0..MAX_ROUNDS {
         let mut short = short_edges(plan, front, columns, &sizes);
         short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         let mut touched = vec![false; columns.len()];
-        let before = made;
+        let before = made.len();
         for (_, a, b) in short {
-            if touched[a as usize] || touched[b as usize] || !plan.merges.can_collapse(front, a, b) {
+            if touched[a as usize]
+                || touched[b as usize]
+                || vetoed.contains(&(a, b))
+                || !plan.merges.can_collapse(front, a, b)
+            {
                 continue;
             }
             if entropy::try_collapse(plan, columns, a, b, &cells_valid) {
                 touched[a as usize] = true;
                 touched[b as usize] = true;
-                made += 1;
+                made.push((a, b));
             }
         }
-        if made == before {
+        if made.len() == before {
             break;
         }
     }

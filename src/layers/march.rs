@@ -163,8 +163,9 @@ pub(super) struct SlabPlan {
     pub redirected: Vec<(u32, DVec3, f64)>,
     /// Merges made, entropy and tangential.
     pub collapses: usize,
-    /// Of those, the tangential collapses of short edges ([`super::coarsen`]).
-    pub coarsened: usize,
+    /// Of those, the tangential collapses of short edges ([`super::coarsen`]), as the pairs of
+    /// columns `(a, b)`, `a < b`, that were their ends.
+    pub coarsened: Vec<(u32, u32)>,
     /// Of those, the collapses of faces left flat along a line ([`entropy::merge_flat_tops`]).
     pub flat_tops: usize,
     /// Columns bent to mend an invalid cell ([`bend::bend_to_mend`]).
@@ -185,7 +186,7 @@ impl SlabPlan {
             merges,
             redirected: Vec::new(),
             collapses: 0,
-            coarsened: 0,
+            coarsened: Vec::new(),
             flat_tops: 0,
             bends: 0,
             tips: 0,
@@ -340,7 +341,7 @@ fn cut_from(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32) -
 
 /// The changes of the front's topology proposed for one slab (tangential adaptivity): splits
 /// of long edges and swaps of badly shaped pairs (the collapses are merges of the plan).
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct Reshape {
     pub splits: Splits,
     pub swaps: Swaps,
@@ -458,7 +459,7 @@ pub fn march(
                 _ => DVec3::ZERO,
             })
             .collect();
-        let mut reshape = match sizes.adapt {
+        let reshape = match sizes.adapt {
             Adapt::Off => Reshape::default(),
             Adapt::Wall | Adapt::Field(_) => {
                 let target = sizes.tangential(&proposed, &columns.alive);
@@ -468,11 +469,12 @@ pub fn march(
             }
         };
         proposed.extend_from_slice(&reshape.splits.top);
-        let plan = settle_slab(mesh, columns, front, proposed, &mut reshape, sizes, walls, &mut guard, k);
+        let (plan, reshape) =
+            settle_slab_keeping_layers(mesh, columns, front, proposed, reshape, sizes, walls, &mut guard, k);
         stats.columns_stopped_early +=
             columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
-        stats.collapses += plan.collapses - plan.coarsened;
-        stats.tangential_collapses += plan.coarsened;
+        stats.collapses += plan.collapses - plan.coarsened.len();
+        stats.tangential_collapses += plan.coarsened.len();
         stats.flat_top_collapses += plan.flat_tops;
         stats.bent_columns += plan.bends;
         stats.tipped_columns += plan.tips;
@@ -659,8 +661,65 @@ fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach
     Reach { end, through_layer: last }
 }
 
+/// [`settle_slab`], taking back the tangential collapses whose columns the slab then stops
+/// where that stops fewer columns: coarsening the front is not worth a layer. The slab is
+/// settled again with those edges kept (each retry vetoes at least one more of the finitely many
+/// collapses, so this ends), and the settling that stops the fewest columns is kept (the first,
+/// with the most collapses, among equals). Returns the plan and the reshaping it settled with.
+#[allow(clippy::too_many_arguments)]
+fn settle_slab_keeping_layers(
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    proposed: Vec<DVec3>,
+    reshape: Reshape,
+    sizes: &Sizes,
+    walls: &VertexWalls,
+    guard: &mut CrossingGuard,
+    k: u32,
+) -> (SlabPlan, Reshape) {
+    let mut vetoed: Vec<(u32, u32)> = Vec::new();
+    let mut best: Option<(usize, SlabPlan, Reshape)> = None;
+    loop {
+        let mut attempt = reshape.clone();
+        let plan = settle_slab(
+            mesh,
+            columns,
+            front,
+            proposed.clone(),
+            &mut attempt,
+            sizes,
+            walls,
+            guard,
+            k,
+            &vetoed,
+        );
+        let stopped = |c: u32| columns.alive[c as usize] && !plan.moving[c as usize];
+        let stops = (0..columns.len() as u32).filter(|&c| stopped(c)).count();
+        let blamed: Vec<(u32, u32)> =
+            plan.coarsened.iter().copied().filter(|&(a, b)| stopped(a) || stopped(b)).collect();
+        if best.as_ref().is_none_or(|(fewest, _, _)| stops < *fewest) {
+            best = Some((stops, plan, attempt));
+        }
+        if blamed.is_empty() {
+            break;
+        }
+        tracing::debug!(
+            ?blamed,
+            "tangential collapses whose columns stopped: settling the slab again without them"
+        );
+        vetoed.extend(blamed);
+    }
+    if !vetoed.is_empty() {
+        // The pairs were last built for another settling's merges.
+        guard.invalidate();
+    }
+    let (_, plan, reshape) = best.expect("settled at least once");
+    (plan, reshape)
+}
+
 /// Decide which columns move and merge so that every cell of the slab is valid and the new
-/// front does not cross itself: first the tangential collapses of short edges (unless
+/// front does not cross itself, leaving the edges `vetoed` uncollapsed: first the tangential collapses of short edges (unless
 /// adaptivity is off), then the merges of face columns passing a concave ridge's bisector
 /// ([`entropy::merge_bisector_crossings`]), then the repairs of invalid cells and of crossings.
 #[allow(clippy::too_many_arguments)]
@@ -674,6 +733,7 @@ fn settle_slab(
     walls: &VertexWalls,
     guard: &mut CrossingGuard,
     k: u32,
+    vetoed: &[(u32, u32)],
 ) -> SlabPlan {
     let mut plan = SlabPlan::new(columns.alive.clone(), proposed);
     {
@@ -683,7 +743,7 @@ fn settle_slab(
             let user = sizes.user(&plan.proposed, &columns.alive);
             let limits = (&reshape.target[..], &user[..], k);
             let coarsening =
-                coarsen::collapse_short_edges(&mut plan, front, columns, limits, |plan, group| {
+                coarsen::collapse_short_edges(&mut plan, front, columns, limits, vetoed, |plan, group| {
                     invalid_cells(plan, group) == 0
                 });
             plan.coarsened = coarsening.made;

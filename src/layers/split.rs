@@ -160,7 +160,7 @@ fn mean_size(h: &[f64], a: usize, b: usize) -> f64 {
 }
 
 /// The splits proposed for one slab.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct Splits {
     /// The columns `[a, b]` of each split edge, `a < b`.
     edges: Vec<[u32; 2]>,

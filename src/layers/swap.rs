@@ -33,7 +33,7 @@ struct Swap {
 }
 
 /// The swaps proposed for one slab.
-#[derive(Debug, Default)]
+#[derive(Clone, Debug, Default)]
 pub(super) struct Swaps {
     swaps: Vec<Swap>,
     /// The swap on each face (`u32::MAX`: none); empty when there are no swaps.
