@@ -174,6 +174,8 @@ pub(super) struct SlabPlan {
     pub tips: usize,
     /// Columns stopped in their transition layers at crushed edges ([`stop_crushed_transition`]).
     pub crushed_stops: usize,
+    /// Columns stopped because the new front crossed itself ([`stop_to_uncross`]).
+    pub uncrossed: Vec<u32>,
 }
 
 impl SlabPlan {
@@ -191,6 +193,7 @@ impl SlabPlan {
             bends: 0,
             tips: 0,
             crushed_stops: 0,
+            uncrossed: Vec::new(),
         }
     }
 
@@ -662,10 +665,12 @@ fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach
 }
 
 /// [`settle_slab`], taking back the tangential collapses whose columns the slab then stops
-/// where that stops fewer columns: coarsening the front is not worth a layer. The slab is
-/// settled again with those edges kept (each retry vetoes at least one more of the finitely many
-/// collapses, so this ends), and the settling that stops the fewest columns is kept (the first,
-/// with the most collapses, among equals). Returns the plan and the reshaping it settled with.
+/// because the new front crossed itself, where that stops fewer columns. A collapse is made only
+/// where the cells around it stay valid, but whether the front crosses itself is known only once
+/// the slab is settled; coarsening the front is not worth a layer. The slab is settled again with
+/// those edges kept (each retry vetoes at least one more of the finitely many collapses, so this
+/// ends), and the settling that stops the fewest columns is kept (the first, with the most
+/// collapses, among equals). Returns the plan and the reshaping it settled with.
 #[allow(clippy::too_many_arguments)]
 fn settle_slab_keeping_layers(
     mesh: &VolumeMesh,
@@ -694,10 +699,10 @@ fn settle_slab_keeping_layers(
             k,
             &vetoed,
         );
-        let stopped = |c: u32| columns.alive[c as usize] && !plan.moving[c as usize];
-        let stops = (0..columns.len() as u32).filter(|&c| stopped(c)).count();
+        let stops = (0..columns.len()).filter(|&c| columns.alive[c] && !plan.moving[c]).count();
+        let uncrossed = |c: u32| plan.uncrossed.contains(&c);
         let blamed: Vec<(u32, u32)> =
-            plan.coarsened.iter().copied().filter(|&(a, b)| stopped(a) || stopped(b)).collect();
+            plan.coarsened.iter().copied().filter(|&(a, b)| uncrossed(a) || uncrossed(b)).collect();
         if best.as_ref().is_none_or(|(fewest, _, _)| stops < *fewest) {
             best = Some((stops, plan, attempt));
         }
@@ -706,7 +711,7 @@ fn settle_slab_keeping_layers(
         }
         tracing::debug!(
             ?blamed,
-            "tangential collapses whose columns stopped: settling the slab again without them"
+            "tangential collapses whose columns stopped where the front crossed itself: settling the slab again without them"
         );
         vetoed.extend(blamed);
     }
@@ -772,7 +777,9 @@ fn settle_slab(
         let crossings = guard.crossings(&plan, reshape, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
         for (f, g) in crossings.pairs {
-            changed.extend(stop_to_uncross(&mut plan, reshape, mesh, columns, front, f, g));
+            let stopped = stop_to_uncross(&mut plan, reshape, mesh, columns, front, f, g);
+            plan.uncrossed.extend(&stopped);
+            changed.extend(stopped);
         }
         for f in crossings.uncappable {
             tracing::debug!(face = f, at = ?wall_points(front, f, columns), "no pyramid caps the quad: stopping its columns");
