@@ -686,6 +686,11 @@ fn settle_slab_keeping_layers(
     let mut vetoed: Vec<(u32, u32)> = Vec::new();
     let mut best: Option<(usize, SlabPlan, Reshape)> = None;
     loop {
+        if !vetoed.is_empty() {
+            // The pairs were built for the last settling's merges; another set of merges of the
+            // same count would pass for them.
+            guard.invalidate();
+        }
         let mut attempt = reshape.clone();
         let plan = settle_slab(
             mesh,
