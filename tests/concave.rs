@@ -310,7 +310,7 @@ fn fronts_meeting_across_a_slot_leave_the_core_a_gap_it_can_fill() {
 /// from lip to bottom) at the families' spec: at layer 10 the walls' fronts have shrunk to a
 /// quarter of their width and the tangential collapses merged lip and bisector columns, which
 /// turned the lips' fans over one another and stopped 43 stacks. A collapse whose columns the
-/// slab then stops is taken back: coarsening is never worth a layer.
+/// slab then stops because the front crosses itself is taken back.
 #[test]
 fn tangential_collapses_never_cost_a_groove_its_layers() {
     let surface = family_body_at(Family::Grooves, 2, 1.0);

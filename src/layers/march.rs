@@ -729,9 +729,10 @@ fn settle_slab_keeping_layers(
 }
 
 /// Decide which columns move and merge so that every cell of the slab is valid and the new
-/// front does not cross itself, leaving the edges `vetoed` uncollapsed: first the tangential collapses of short edges (unless
-/// adaptivity is off), then the merges of face columns passing a concave ridge's bisector
-/// ([`entropy::merge_bisector_crossings`]), then the repairs of invalid cells and of crossings.
+/// front does not cross itself, leaving the edges `vetoed` uncollapsed: first the tangential
+/// collapses of short edges (unless adaptivity is off), then the merges of face columns passing
+/// a concave ridge's bisector ([`entropy::merge_bisector_crossings`]), then the repairs of
+/// invalid cells and of crossings.
 #[allow(clippy::too_many_arguments)]
 fn settle_slab(
     mesh: &VolumeMesh,
