@@ -10,6 +10,13 @@ const LEAF_SIZE: usize = 4;
 #[derive(Clone, Debug)]
 struct Node {
     bounds: Aabb,
+    /// A box holding the node's triangles in a frame of its own: the mean normal and two
+    /// directions across it, with the lowest and highest coordinates of their corners along
+    /// each. On a patch of wall it is as thin as the patch is curved and as wide as the patch,
+    /// where the axis-aligned box is as thick as the patch is wide and tilted, so it bounds the
+    /// distance from points above the wall (layer fronts) far more tightly.
+    frame: [DVec3; 3],
+    extent: [[f64; 2]; 3],
     /// Leaf: `triangles[first..first + count]`; inner node: children `first` and `first + 1`.
     first: u32,
     count: u32,
@@ -57,10 +64,38 @@ impl TriangleBvh {
     }
 
     fn leaf(&self, first: usize, count: usize) -> Node {
-        let bounds = Aabb::from_points(
-            self.order[first..first + count].iter().flat_map(|&t| &self.corners[t as usize]),
-        );
-        Node { bounds, first: first as u32, count: count as u32 }
+        let triangles = || self.order[first..first + count].iter().map(|&t| &self.corners[t as usize]);
+        let bounds = Aabb::from_points(triangles().flatten());
+        let normal = triangles()
+            .map(|&[a, b, c]| super::triangle_area_vector(a, b, c))
+            .sum::<DVec3>()
+            .try_normalize()
+            .unwrap_or(DVec3::Z);
+        let across = normal.any_orthonormal_vector();
+        let frame = [normal, across, normal.cross(across)];
+        let mut extent = [[f64::INFINITY, f64::NEG_INFINITY]; 3];
+        for x in triangles().flatten() {
+            for (axis, range) in frame.iter().zip(&mut extent) {
+                let h = axis.dot(*x);
+                *range = [range[0].min(h), range[1].max(h)];
+            }
+        }
+        Node { bounds, frame, extent, first: first as u32, count: count as u32 }
+    }
+
+    /// A lower bound of the squared distance from `p` to the triangles of node `n`: the larger
+    /// of the distances to its two boxes (the framed one's less a relative margin that covers
+    /// the rounding of the dot products).
+    fn node_distance_squared(&self, p: DVec3, n: usize) -> f64 {
+        let node = &self.nodes[n];
+        let mut framed = 0.0;
+        for (axis, &[lo, hi]) in node.frame.iter().zip(&node.extent) {
+            let h = axis.dot(p);
+            let margin = 1e-9 * (h.abs() + lo.abs().max(hi.abs()));
+            let gap = ((lo - h).max(h - hi) - margin).max(0.0);
+            framed += gap * gap;
+        }
+        box_distance_squared(p, &node.bounds).max(framed)
     }
 
     /// Split node `n` at the median centroid along its longest centroid axis, recursively.
@@ -89,10 +124,18 @@ impl TriangleBvh {
     /// The closest point of all triangles to `p` (`None` for an empty set). Exact with respect
     /// to `closest_point_on_triangle`; ties go to the lower triangle id.
     pub fn nearest(&self, p: DVec3) -> Option<Nearest> {
+        self.nearest_within(p, f64::INFINITY)
+    }
+
+    /// [`nearest`](Self::nearest) when it is closer than `reach`, else `None`: subtrees
+    /// farther than `reach` are never searched, so a query that only has to rule out the nearby
+    /// triangles costs a few boxes instead of a descent to the nearest leaf.
+    pub fn nearest_within(&self, p: DVec3, reach: f64) -> Option<Nearest> {
         let mut best: Option<Nearest> = None;
-        let mut best_d2 = f64::INFINITY;
-        self.branch_and_bound(
-            |bounds| box_distance_squared(p, bounds),
+        let mut best_d2 = reach * reach;
+        self.search(
+            best_d2,
+            |_, n| self.node_distance_squared(p, n),
             |t, corners| {
                 let q = closest_point_on_triangle(p, corners[0], corners[1], corners[2]);
                 let d2 = (q - p).length_squared();
@@ -111,23 +154,36 @@ impl TriangleBvh {
     /// returns the best cost so far. Subtrees whose bound exceeds the best are skipped.
     pub fn branch_and_bound(
         &self,
-        mut node_bound: impl FnMut(&Aabb) -> f64,
-        mut visit: impl FnMut(u32, &[DVec3; 3]) -> f64,
+        node_bound: impl FnMut(&Aabb) -> f64,
+        visit: impl FnMut(u32, &[DVec3; 3]) -> f64,
     ) {
-        self.branch_and_bound_nodes(|bounds, _| node_bound(bounds), &mut visit);
+        let mut node_bound = node_bound;
+        self.search(f64::INFINITY, |bounds, _| node_bound(bounds), visit);
     }
 
     /// As [`branch_and_bound`](Self::branch_and_bound), the bound also given the node index (for
     /// per-node data from [`node_minimum`](Self::node_minimum)).
     pub fn branch_and_bound_nodes(
         &self,
+        node_bound: impl FnMut(&Aabb, usize) -> f64,
+        visit: impl FnMut(u32, &[DVec3; 3]) -> f64,
+    ) {
+        self.search(f64::INFINITY, node_bound, visit);
+    }
+
+    /// The search of [`branch_and_bound_nodes`](Self::branch_and_bound_nodes), with costs
+    /// above `ceiling` of no interest: subtrees whose bound exceeds it are skipped from the
+    /// start.
+    fn search(
+        &self,
+        ceiling: f64,
         mut node_bound: impl FnMut(&Aabb, usize) -> f64,
         mut visit: impl FnMut(u32, &[DVec3; 3]) -> f64,
     ) {
         if self.nodes.is_empty() {
             return;
         }
-        let mut best = f64::INFINITY;
+        let mut best = ceiling;
         let mut stack: Vec<(usize, f64)> = Vec::with_capacity(64);
         stack.push((0, node_bound(&self.nodes[0].bounds, 0)));
         while let Some((n, bound)) = stack.pop() {
@@ -281,6 +337,22 @@ mod tests {
                 prop_assert_eq!(near.distance, brute(&c, p));
                 let t = c[near.triangle as usize];
                 prop_assert_eq!(closest_point_on_triangle(p, t[0], t[1], t[2]), near.point);
+            }
+        }
+
+        /// Within a reach, the nearest is found exactly when it is closer than the reach, and
+        /// nothing otherwise.
+        #[test]
+        fn nearest_within_a_reach_is_the_nearest_or_none(level in 0usize..3, n in 1usize..4,
+                                   box_not_sphere in any::<bool>(), reach in 0.0f64..3.0,
+                                   size in proptest::array::uniform3(0.1f64..3.0),
+                                   points in proptest::collection::vec(proptest::array::uniform3(-4.0f64..4.0), 20)) {
+            let s = if box_not_sphere { cuboid(DVec3::from_array(size), n) } else { icosphere(size[0], level) };
+            let bvh = TriangleBvh::new(corners(&s));
+            for p in points.into_iter().map(DVec3::from_array) {
+                let near = bvh.nearest(p).unwrap();
+                let within = bvh.nearest_within(p, reach);
+                prop_assert_eq!(within, (near.distance < reach).then_some(near));
             }
         }
     }

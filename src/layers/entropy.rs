@@ -29,6 +29,7 @@ use rayon::prelude::*;
 
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
+use crate::geometry::distance::closest_point_on_triangle;
 use crate::sizing::wall::WallDistance;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
@@ -116,6 +117,8 @@ pub struct VertexWalls<'a> {
     normals: Vec<DVec3>,
     /// The triangles of the patches with layers (the others are no front to be overtaken by).
     layered: WallDistance,
+    /// Every wall triangle's index in `layered` (`u32::MAX` for those without layers).
+    layered_index: Vec<u32>,
 }
 
 impl<'a> VertexWalls<'a> {
@@ -126,10 +129,15 @@ impl<'a> VertexWalls<'a> {
             (0..surface.triangles.len()).filter(|&t| layered(surface.triangle_patch[t])).collect();
         walls.triangles = keep.iter().map(|&t| surface.triangles[t]).collect();
         walls.triangle_patch = keep.iter().map(|&t| surface.triangle_patch[t]).collect();
+        let mut layered_index = vec![u32::MAX; surface.triangles.len()];
+        for (i, &t) in keep.iter().enumerate() {
+            layered_index[t] = i as u32;
+        }
         VertexWalls {
             topology,
             normals: (0..surface.triangles.len()).map(|t| surface.triangle_normal(t)).collect(),
             layered: WallDistance::new(&walls),
+            layered_index,
         }
     }
 
@@ -149,6 +157,28 @@ impl<'a> VertexWalls<'a> {
     /// Distance from `p` to the nearest wall with layers (infinite when there is none).
     pub fn distance(&self, p: DVec3) -> f64 {
         self.layered.closest(p).map_or(f64::INFINITY, |w| w.distance)
+    }
+
+    /// [`distance`](Self::distance) when it is below `reach`, else `None` (a search that
+    /// skips everything farther).
+    pub fn distance_within(&self, p: DVec3, reach: f64) -> Option<f64> {
+        self.layered.bvh().nearest_within(p, reach).map(|near| near.distance)
+    }
+
+    /// An upper bound of [`distance`](Self::distance) at `p` for a point of wall vertex `v`'s
+    /// column: the distance to the triangles with layers at `v` (infinite when there are none).
+    pub fn distance_bound(&self, v: u32, p: DVec3) -> f64 {
+        let triangles =
+            if (v as usize) < self.topology.vertex_count() { self.topology.vertex_triangles(v) } else { &[] };
+        triangles
+            .iter()
+            .map(|&t| self.layered_index[t as usize])
+            .filter(|&i| i != u32::MAX)
+            .map(|i| {
+                let [a, b, c] = self.layered.bvh().corners(i);
+                closest_point_on_triangle(p, a, b, c).distance(p)
+            })
+            .fold(f64::INFINITY, f64::min)
     }
 }
 
@@ -234,9 +264,21 @@ fn lateness(
         return 0.0;
     };
     let h = d - d_below;
-    let top = (d - walls.distance(plan.proposed[c as usize])) / h;
-    let bottom = (d_below - walls.distance(points[columns.node[c as usize] as usize])) / h;
-    if h > 0.0 && top - bottom > FALLING_BEHIND {
+    if h <= 0.0 {
+        return 0.0;
+    }
+    let (top_point, bottom_point) = (plan.proposed[c as usize], points[columns.node[c as usize] as usize]);
+    // Falling behind means a top less than (1 - FALLING_BEHIND) h farther from the walls than
+    // the bottom: with the bottom's distance bounded by its own wall's triangles, most columns
+    // are ruled out by a search that skips everything farther (the margin covers rounding).
+    let reach =
+        walls.distance_bound(columns.wall_vertex[c as usize], bottom_point) + (1.0 - FALLING_BEHIND) * h;
+    let Some(top_distance) = walls.distance_within(top_point, reach + 1e-9 * (reach.abs() + h)) else {
+        return 0.0;
+    };
+    let top = (d - top_distance) / h;
+    let bottom = (d_below - walls.distance(bottom_point)) / h;
+    if top - bottom > FALLING_BEHIND {
         top + ANTICIPATION * (top - bottom)
     } else {
         0.0

@@ -1002,11 +1002,10 @@ fn plan_gaps(columns: &Columns, walls: &VertexWalls, rooms: &mut Vec<f64>) {
             let first = columns.distance(c, 1)?;
             let reach = 2.0 * full;
             let (base, dir) = (columns.base[c], columns.dir[c]);
-            // The wall point still nearest at `reach` along the column: the distance rises all
-            // the way there (it is 1-Lipschitz), so the climb would not stall.
-            if walls.distance(base + dir * reach) >= reach * (1.0 - 1e-9) {
-                return None;
-            }
+            // Only a wall nearer than `reach` at `reach` along the column makes a gap: without
+            // one the distance rises all the way there (it is 1-Lipschitz), so the climb would
+            // not stall.
+            walls.distance_within(base + dir * reach, reach * (1.0 - 1e-9))?;
             let room = walls.room_above(base, dir, reach);
             (room < reach && room > first).then_some((c, room))
         })
