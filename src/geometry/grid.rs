@@ -12,7 +12,7 @@ const AXIS_MAX: i64 = (1 << AXIS_BITS) - 1;
 const MAX_CELLS_PER_BOX: i64 = 4096;
 
 /// The pairs `(a, b)`, `a < b`, of overlapping (touching counts) boxes with at least one of them
-/// a query (`is_query[i]`).
+/// a query (`is_query[i]`), each once, in no particular order (but the same every run).
 pub fn overlapping_pairs(boxes: &[Aabb], is_query: &[bool]) -> Vec<(u32, u32)> {
     overlapping_pairs_where(boxes, is_query, |_, _| true)
 }
@@ -66,16 +66,28 @@ pub fn overlapping_pairs_where(
     let mut pairs: Vec<(u32, u32)> = groups
         .par_iter()
         .flat_map_iter(|group| {
+            // Sweep the cell's boxes by their low x: a box meets only those starting before it
+            // ends along x.
+            let mut by_x: Vec<(f64, u32)> =
+                group.iter().map(|&(_, b)| (boxes[b as usize].min.x, b)).collect();
+            by_x.sort_unstable_by(|x, y| x.0.total_cmp(&y.0).then(x.1.cmp(&y.1)));
+            let k = group[0].0;
             let mut out = Vec::new();
-            for (i, &(k, a)) in group.iter().enumerate() {
-                for &(_, b) in &group[i + 1..] {
-                    let (ba, bb) = (&boxes[a as usize], &boxes[b as usize]);
+            for (i, &(_, a)) in by_x.iter().enumerate() {
+                let ba = &boxes[a as usize];
+                for &(min_x, b) in &by_x[i + 1..] {
+                    if min_x > ba.max.x {
+                        break;
+                    }
+                    let bb = &boxes[b as usize];
                     if !(is_query[a as usize] || is_query[b as usize]) || !ba.overlaps(bb) {
                         continue;
                     }
                     // Report from one cell only.
                     let (la, lb) = (low[a as usize], low[b as usize]);
-                    if key([la[0].max(lb[0]), la[1].max(lb[1]), la[2].max(lb[2])]) == k && keep(a, b) {
+                    if key([la[0].max(lb[0]), la[1].max(lb[1]), la[2].max(lb[2])]) == k
+                        && keep(a.min(b), a.max(b))
+                    {
                         out.push((a.min(b), a.max(b)));
                     }
                 }
@@ -83,6 +95,8 @@ pub fn overlapping_pairs_where(
             out
         })
         .collect();
+    // The boxes out of the grid meet every box directly (a pair of two of them twice).
+    let mut with_big = Vec::new();
     for &b in &big {
         for a in 0..boxes.len() as u32 {
             if a != b
@@ -90,12 +104,13 @@ pub fn overlapping_pairs_where(
                 && boxes[a as usize].overlaps(&boxes[b as usize])
                 && keep(a.min(b), a.max(b))
             {
-                pairs.push((a.min(b), a.max(b)));
+                with_big.push((a.min(b), a.max(b)));
             }
         }
     }
-    pairs.par_sort_unstable();
-    pairs.dedup();
+    with_big.sort_unstable();
+    with_big.dedup();
+    pairs.extend(with_big);
     pairs
 }
 
@@ -103,6 +118,11 @@ pub fn overlapping_pairs_where(
 mod tests {
     use super::*;
     use proptest::prelude::*;
+
+    fn sorted(mut pairs: Vec<(u32, u32)>) -> Vec<(u32, u32)> {
+        pairs.sort_unstable();
+        pairs
+    }
 
     fn brute(boxes: &[Aabb], q: &[bool]) -> Vec<(u32, u32)> {
         let mut out = Vec::new();
@@ -126,7 +146,7 @@ mod tests {
                 Aabb { min, max: min + DVec3::from_array(*s) }
             }).collect();
             let q: Vec<bool> = raw.iter().map(|r| r.2).collect();
-            prop_assert_eq!(overlapping_pairs(&boxes, &q), brute(&boxes, &q));
+            prop_assert_eq!(sorted(overlapping_pairs(&boxes, &q)), brute(&boxes, &q));
         }
     }
 
@@ -137,6 +157,6 @@ mod tests {
             .collect();
         boxes.push(Aabb { min: DVec3::splat(-1e6), max: DVec3::splat(1e6) });
         let q = vec![true; boxes.len()];
-        assert_eq!(overlapping_pairs(&boxes, &q), brute(&boxes, &q));
+        assert_eq!(sorted(overlapping_pairs(&boxes, &q)), brute(&boxes, &q));
     }
 }

@@ -559,10 +559,13 @@ pub fn intersecting_pairs_with(surface: &Surface, queries: &[u32], distant_only:
     for &q in queries {
         is_query[q as usize] = true;
     }
-    overlapping_pairs_where(&boxes, &is_query, |a, b| !distant_only || !shares_vertex(surface, a, b))
-        .into_par_iter()
-        .filter(|&(a, b)| triangle_pair_intersects(surface, a, b))
-        .collect()
+    let mut pairs: Vec<(u32, u32)> =
+        overlapping_pairs_where(&boxes, &is_query, |a, b| !distant_only || !shares_vertex(surface, a, b))
+            .into_par_iter()
+            .filter(|&(a, b)| triangle_pair_intersects(surface, a, b))
+            .collect();
+    pairs.sort_unstable();
+    pairs
 }
 
 fn shares_vertex(surface: &Surface, a: u32, b: u32) -> bool {
