@@ -363,6 +363,17 @@ impl Reshape {
         }
         self.splits.give_up(f, plan)
     }
+
+    /// The faces whose cells change with the columns `changed`: the faces around them, and both
+    /// faces of a swap with one of them (its face without that column turns back into a cell of
+    /// its own when the swap is no longer made).
+    fn faces_around_columns(&self, front: &Front, changed: &[u32]) -> Vec<usize> {
+        let mut faces = front.faces_around_columns(changed);
+        faces.extend(self.swaps.faces_with_columns(changed));
+        faces.sort_unstable();
+        faces.dedup();
+        faces
+    }
 }
 
 /// The cell over front face `f` under a slab plan, with its active splits and swap; the new
@@ -794,7 +805,7 @@ fn settle_slab(
         if changed.is_empty() {
             return plan;
         }
-        to_check = front.faces_around_columns(&changed);
+        to_check = reshape.faces_around_columns(front, &changed);
         suspects = to_check.clone();
     }
 }
@@ -951,7 +962,7 @@ fn repair_invalid_cells(
         }
         // Only the cells around a column that stopped or merged, or on a split given up, change;
         // the invalid ones left wait for the next round.
-        to_check = front.faces_around_columns(&changed);
+        to_check = reshape.faces_around_columns(front, &changed);
         to_check.extend(changed_faces);
         changed_anywhere.extend_from_slice(&to_check);
         to_check.extend(uncollapsed);

@@ -1,7 +1,10 @@
 //! Edge swaps on the front (tangential adaptivity): where two front
 //! triangles `(a, b, c)` and `(b, a, d)` would top out badly shaped (splits fan long edges from
 //! their middle; columns converge), their shared edge is swapped for `(c, d)`: the new front has
-//! the triangles `(c, a, d)` and `(d, b, c)`.
+//! the triangles `(c, a, d)` and `(d, b, c)`. Along a concave ridge, where face columns merge
+//! into the ridge's, a face can end up with its three columns on the ridge: a sliver lying in
+//! the front's crease, which pinches it (the core then meets it with slivers); it is swapped
+//! with its neighbour across its long edge like a pair a split made.
 //!
 //! In the slab being built, the two cells over the pair become one polyhedron: the two bottom
 //! triangles with the old diagonal, the two top triangles with the new one, and the four lateral
@@ -12,7 +15,7 @@
 
 use glam::DVec3;
 
-use super::front::{Columns, Front};
+use super::front::{Columns, Front, NOT_MERGED};
 use super::march::SlabPlan;
 use super::slab::{self, cell_from_faces, Polygon, SlabCell};
 use super::split::Splits;
@@ -85,6 +88,19 @@ impl Swaps {
         self.swaps[s].faces.map(|g| g as usize).to_vec()
     }
 
+    /// Both faces of every enabled swap with one of the `columns`.
+    pub fn faces_with_columns(&self, columns: &[u32]) -> Vec<usize> {
+        if self.swaps.is_empty() || columns.is_empty() {
+            return Vec::new();
+        }
+        let changed: std::collections::HashSet<u32> = columns.iter().copied().collect();
+        self.swaps
+            .iter()
+            .filter(|swap| swap.enabled && swap.columns.iter().any(|c| changed.contains(c)))
+            .flat_map(|swap| swap.faces.map(|f| f as usize))
+            .collect()
+    }
+
     /// The swaps made under `plan`.
     pub fn active<'a>(&'a self, plan: &'a SlabPlan) -> impl Iterator<Item = usize> + 'a {
         (0..self.len()).filter(move |&s| self.is_active(s, plan))
@@ -92,13 +108,15 @@ impl Swaps {
 }
 
 /// Propose swaps on the front with the tops at `proposed`: pairs of triangles of one patch whose
-/// four columns are alive and slide alike, one of them born by a split (the wall's own triangles
-/// are never swapped: their first cells stay prisms on the wall), with no split on their edges,
+/// four columns are alive and slide alike, one of them born by a split or the poor face reshaped
+/// by a merge (the wall's own triangles are never swapped: their first cells stay prisms on the
+/// wall), with no split on their edges,
 /// whose worst top angle is poor and would gain by the swap without folding; each column in one
 /// swap at most, the worst pairs first.
 pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], splits: &Splits) -> Swaps {
     let mut candidates: Vec<(f64, Swap)> = Vec::new();
     let split_faces = splits.faces_with_splits(front.len());
+    let reshaped = faces_reshaped_by_merges(columns, front);
     for f in 0..front.len() {
         let cols = front.face_columns(f);
         if cols.len() != 3 || split_faces[f] || !cols.iter().all(|&c| columns.alive[c as usize]) {
@@ -124,8 +142,9 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
             if !four.iter().all(|&x| usable(x)) || c == d || front.are_neighbours(c, d) {
                 continue;
             }
-            // The wall's own triangulation is the user's: only pairs a split made are swapped.
-            if four.iter().all(|&x| columns.born_at[x as usize] == 0) {
+            // The wall's own triangulation is the user's: only pairs a split made, or a merge
+            // reshaped, are swapped.
+            if four.iter().all(|&x| columns.born_at[x as usize] == 0) && !reshaped[f] {
                 continue;
             }
             let at = four.map(|x| proposed[x as usize]);
@@ -157,6 +176,17 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
         swaps.swaps.push(swap);
     }
     swaps
+}
+
+/// Whether every face is no longer its wall triangle's shape because a column merged into one
+/// of its columns: it then spans other wall vertices (along a concave ridge, three columns on
+/// the ridge itself, a sliver that only a swap turns back into the front's shape).
+fn faces_reshaped_by_merges(columns: &Columns, front: &Front) -> Vec<bool> {
+    let mut carries = vec![false; columns.len()];
+    for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
+        carries[r as usize] = true;
+    }
+    (0..front.len()).map(|f| front.face_columns(f).iter().any(|&c| carries[c as usize])).collect()
 }
 
 /// The other face on the front edge `(a, b)` of face `f` (a triangle), if it is a triangle
@@ -232,6 +262,20 @@ mod tests {
         assert!(gain([p(0.0, 0.0), p(1.0, 0.0), p(0.5, h), p(0.5, -h)]).is_none());
         // A non-convex pair: the swap would fold.
         assert!(gain([p(0.0, 0.0), p(4.0, 0.0), p(0.5, 0.3), p(-1.0, -0.2)]).is_none());
+    }
+
+    /// A swap's two faces change together: the face without a column that changes turns back
+    /// into a cell of its own when the swap is no longer made, so both must be looked at again.
+    #[test]
+    fn both_faces_of_a_swap_change_with_any_of_its_columns() {
+        let swap = Swap { faces: [4, 7], columns: [0, 1, 2, 3], enabled: true };
+        let swaps = Swaps { swaps: vec![swap], on_face: Vec::new() };
+        for c in 0..4 {
+            assert_eq!(swaps.faces_with_columns(&[9, c]), vec![4, 7]);
+        }
+        assert!(swaps.faces_with_columns(&[9]).is_empty());
+        let given_up = Swaps { swaps: vec![Swap { enabled: false, ..swap }], on_face: Vec::new() };
+        assert!(given_up.faces_with_columns(&[3]).is_empty());
     }
 
     #[test]
