@@ -180,13 +180,25 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
 
 /// Whether every face is no longer its wall triangle's shape because a column merged into one
 /// of its columns: it then spans other wall vertices (along a concave ridge, three columns on
-/// the ridge itself, a sliver that only a swap turns back into the front's shape).
+/// the ridge itself, a sliver that only a swap turns back into the front's shape). Faces with a
+/// fan's column are left as they are: next to a fan's strip of quads, a swapped pair's new edge
+/// can run under the pyramid that will cap a quad (fandisk: 12 stacks stopped).
 fn faces_reshaped_by_merges(columns: &Columns, front: &Front) -> Vec<bool> {
     let mut carries = vec![false; columns.len()];
     for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
         carries[r as usize] = true;
     }
-    (0..front.len()).map(|f| front.face_columns(f).iter().any(|&c| carries[c as usize])).collect()
+    let mut per_vertex = vec![0u32; columns.wall_vertex_count()];
+    for &v in &columns.wall_vertex {
+        per_vertex[v as usize] += 1;
+    }
+    let fan = |c: u32| per_vertex[columns.wall_vertex[c as usize] as usize] > 1;
+    (0..front.len())
+        .map(|f| {
+            let cols = front.face_columns(f);
+            cols.iter().any(|&c| carries[c as usize]) && !cols.iter().any(|&c| fan(c))
+        })
+        .collect()
 }
 
 /// The other face on the front edge `(a, b)` of face `f` (a triangle), if it is a triangle
