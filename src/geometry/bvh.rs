@@ -154,10 +154,9 @@ impl TriangleBvh {
     /// returns the best cost so far. Subtrees whose bound exceeds the best are skipped.
     pub fn branch_and_bound(
         &self,
-        node_bound: impl FnMut(&Aabb) -> f64,
+        mut node_bound: impl FnMut(&Aabb) -> f64,
         visit: impl FnMut(u32, &[DVec3; 3]) -> f64,
     ) {
-        let mut node_bound = node_bound;
         self.search(f64::INFINITY, |bounds, _| node_bound(bounds), visit);
     }
 

@@ -9,8 +9,9 @@
 //! climbing the exact wall distance from the top (away from the nearest wall points, along a
 //! shock where two meet) gains less than that layer before the climb stalls at the medial
 //! surface of a gap (where two walls within [`FACING_ANGLE_DEG`] of facing each other meet:
-//! across a slot, at a slot's bottom corners and lips, in a narrow wedge). Where the front closes on an axis, as in a bore, two layers. The fronts at a
-//! concave ridge of a wider angle go on along its bisector, so a stop there is never excused.
+//! across a slot, at a slot's bottom corners and lips, in a narrow wedge). Where the front
+//! closes on an axis, as in a bore, two layers. The fronts at a concave ridge of a wider angle
+//! go on along its bisector, so a stop there is never excused.
 
 use glam::DVec3;
 use rayon::prelude::*;
