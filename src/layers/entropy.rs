@@ -143,9 +143,16 @@ impl<'a> VertexWalls<'a> {
 
     /// The normals at wall vertex `v` (none for a vertex off the surface).
     pub fn at(&self, v: u32) -> impl Iterator<Item = DVec3> + '_ {
-        let triangles =
-            if (v as usize) < self.topology.vertex_count() { self.topology.vertex_triangles(v) } else { &[] };
-        triangles.iter().map(|&t| self.normals[t as usize])
+        self.triangles_at(v).iter().map(|&t| self.normals[t as usize])
+    }
+
+    /// The wall triangles at wall vertex `v` (none for a vertex off the surface).
+    fn triangles_at(&self, v: u32) -> &[u32] {
+        if (v as usize) < self.topology.vertex_count() {
+            self.topology.vertex_triangles(v)
+        } else {
+            &[]
+        }
     }
 
     /// How much farther from the walls with layers the front can climb from `top`, up to
@@ -168,9 +175,7 @@ impl<'a> VertexWalls<'a> {
     /// An upper bound of [`distance`](Self::distance) at `p` for a point of wall vertex `v`'s
     /// column: the distance to the triangles with layers at `v` (infinite when there are none).
     pub fn distance_bound(&self, v: u32, p: DVec3) -> f64 {
-        let triangles =
-            if (v as usize) < self.topology.vertex_count() { self.topology.vertex_triangles(v) } else { &[] };
-        triangles
+        self.triangles_at(v)
             .iter()
             .map(|&t| self.layered_index[t as usize])
             .filter(|&i| i != u32::MAX)
