@@ -188,15 +188,15 @@ fn faces_reshaped_by_merges(columns: &Columns, front: &Front) -> Vec<bool> {
     for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
         carries[r as usize] = true;
     }
-    let mut mates = Vec::new();
-    let mut in_fan = |c: u32| {
-        front.fan_mates(columns, c as usize, &mut mates);
-        !mates.is_empty()
-    };
+    let mut per_vertex = vec![0u32; columns.wall_vertex_count()];
+    for &v in &columns.wall_vertex {
+        per_vertex[v as usize] += 1;
+    }
+    let fan = |c: u32| per_vertex[columns.wall_vertex[c as usize] as usize] > 1;
     (0..front.len())
         .map(|f| {
             let cols = front.face_columns(f);
-            cols.iter().any(|&c| carries[c as usize]) && !cols.iter().any(|&c| in_fan(c))
+            cols.iter().any(|&c| carries[c as usize]) && !cols.iter().any(|&c| fan(c))
         })
         .collect()
 }
