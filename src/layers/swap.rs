@@ -181,8 +181,10 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
 /// Whether every face is no longer its wall triangle's shape because a column merged into one
 /// of its columns: it then spans other wall vertices (along a concave ridge, three columns on
 /// the ridge itself, a sliver that only a swap turns back into the front's shape). Faces with a
-/// fan's column are left as they are: next to a fan's strip of quads, a swapped pair's new edge
-/// can run under the pyramid that will cap a quad (fandisk: 12 stacks stopped).
+/// column of a wall vertex that has others (a fan's, or one whose edges were split: the split
+/// columns take its wall vertex) are left as they are: next to a fan's strip of quads, a
+/// swapped pair's new edge can run under the pyramid that will cap a quad (fandisk: 12 stacks
+/// stopped).
 fn faces_reshaped_by_merges(columns: &Columns, front: &Front) -> Vec<bool> {
     let mut carries = vec![false; columns.len()];
     for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
