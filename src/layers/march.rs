@@ -1265,7 +1265,7 @@ fn commit_slab(
         })
         .collect();
     // The cells are decided in parallel, then emitted in face order (deterministic output).
-    let cells: Vec<(bool, SlabCell)> = (0..front.len())
+    let mut cells: Vec<(bool, SlabCell)> = (0..front.len())
         .into_par_iter()
         .map(|f| {
             let moved = front.face_columns(f).iter().any(|&c| top[c as usize] != columns.node[c as usize]);
@@ -1274,6 +1274,19 @@ fn commit_slab(
             (moved, cell)
         })
         .collect();
+    let turns = if plan.collapses > 0 && !matches!(sizes.adapt, Adapt::Off) {
+        let reshaped: Vec<bool> = (0..front.len())
+            .map(|f| {
+                reshape.swaps.role(f, plan).is_some() || reshape.splits.active_on_face(f, plan).is_some()
+            })
+            .collect();
+        let proposal = Proposal { points: &mesh.points, proposed: &[], committed: u32::MAX };
+        swap::turn_merged_tops(front, columns, plan, &reshaped, &top, &mesh.points, &mut cells, |cell| {
+            proposal.cell_is_valid(cell)
+        })
+    } else {
+        Vec::new()
+    };
     for (f, (moved, cell)) in cells.into_iter().enumerate() {
         if moved {
             // The top is now front, even under a flat cell whose top lies on a neighbour's face.
@@ -1303,7 +1316,13 @@ fn commit_slab(
         columns.dir[c as usize] = dir;
         columns.scale[c as usize] = scale;
     }
-    let swapped = swap::commit(&reshape.swaps, plan, front);
+    let mut swapped = swap::commit(&reshape.swaps, plan, front);
+    for turn in &turns {
+        let [a, b, c, d] = turn.columns;
+        front.subdivide_face(turn.faces[0], &[vec![c, a, d]]);
+        front.subdivide_face(turn.faces[1], &[vec![d, b, c]]);
+    }
+    swapped += turns.len();
     let old_count = columns.len() as u32;
     let made = split::commit(splits, plan, &mid_node, k, columns, front, sizes);
     if plan.collapses > 0 {

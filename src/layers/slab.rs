@@ -69,7 +69,7 @@ impl Polygon {
     }
 
     /// The same nodes in the same cyclic order (whatever the first one).
-    fn same_cycle(&self, other: &Polygon) -> bool {
+    pub fn same_cycle(&self, other: &Polygon) -> bool {
         let (a, b) = (self.nodes(), other.nodes());
         a.len() == b.len() && (0..b.len()).any(|shift| (0..a.len()).all(|i| a[i] == b[(i + shift) % b.len()]))
     }
@@ -164,6 +164,15 @@ pub fn remove_opposite_pairs(faces: &mut Vec<Polygon>) {
             None => i += 1,
         }
     }
+}
+
+/// Whether the outward `faces` close a polyhedron: every directed edge once, and its reverse
+/// once.
+pub fn is_closed(faces: &[Polygon]) -> bool {
+    let mut edges: Vec<(u32, u32)> = faces.iter().flat_map(|f| f.edges()).collect();
+    edges.sort_unstable();
+    let unique = edges.windows(2).all(|w| w[0] != w[1]);
+    unique && edges.iter().all(|&(a, b)| edges.binary_search(&(b, a)).is_ok())
 }
 
 /// Decide the cell over a front face (see module docs).
@@ -405,6 +414,16 @@ mod tests {
             assert!(faces_c.iter().any(|f| f.same_cycle(&half)), "{faces_c:?}");
             assert!(faces_a.iter().any(|f| f.same_cycle(&half.reversed())), "{faces_a:?}");
         }
+    }
+
+    #[test]
+    fn a_cell_is_closed_by_all_its_faces_and_open_without_one() {
+        let faces = slab_faces(&[0, 1, 2], &[3, 4, 5], Merging::default());
+        assert!(is_closed(&faces));
+        assert!(!is_closed(&faces[1..]));
+        let mut twice = faces.clone();
+        twice.extend(faces);
+        assert!(!is_closed(&twice), "a face twice");
     }
 
     #[test]

@@ -178,6 +178,170 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
     swaps
 }
 
+/// A pair of new front triangles turned over their shared edge in the slab whose merges made
+/// them: faces `faces[0]` and `faces[1]` of the front before the merges become `(c, a, d)` and
+/// `(d, b, c)` of the survivors `[a, b, c, d]`.
+pub(super) struct MergedTurn {
+    pub faces: [usize; 2],
+    pub columns: [u32; 4],
+}
+
+/// Turn the new front's pairs that this slab's merges left badly shaped along a ridge, in the
+/// slab that made them: where face columns merge into a concave ridge's columns, a face can end
+/// with its three columns on the ridge (each carries merged columns), a sliver lying in the
+/// front's crease that pinches it for the core; the next slab's swaps come a layer late, and
+/// after the last slab never. `cells[f]` is the cell over face `f` with the survivors' tops
+/// `top`; a turned pair's two cells become one polyhedron with the new top diagonal (its other
+/// faces are the two cells' faces, so the slab stays conforming), split from its centre, and
+/// the turn is made only when that cell is valid by `is_valid`. As in [`propose`]: faces of one
+/// patch, no fan's column, no split or swap of their own (`reshaped_otherwise`), poor and
+/// gaining by the turn, the worst first, each survivor in one turn at most.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn turn_merged_tops(
+    front: &Front,
+    columns: &Columns,
+    plan: &SlabPlan,
+    reshaped_otherwise: &[bool],
+    top: &[u32],
+    points: &[DVec3],
+    cells: &mut [(bool, SlabCell)],
+    is_valid: impl Fn(&SlabCell) -> bool,
+) -> Vec<MergedTurn> {
+    let merges = &plan.merges;
+    let fan = fan_columns(columns);
+    let after = |f: usize| -> Option<[u32; 3]> {
+        let roots: Vec<u32> = front.face_columns(f).iter().map(|&c| merges.root(c)).collect();
+        let polygon = Polygon::dedup(&roots)?;
+        let n = polygon.nodes();
+        (n.len() == 3 && n.iter().all(|&c| plan.moving[c as usize])).then(|| [n[0], n[1], n[2]])
+    };
+    let at = |c: u32| points[top[c as usize] as usize];
+    let faces_after_around = |root: u32| {
+        merges.group(root).flat_map(|x| front.faces_of(x)).filter_map(move |g| after(g).map(|t| (g, t)))
+    };
+    let mut carries = carrying_merged(columns);
+    for c in 0..columns.len() as u32 {
+        if merges.is_merged(c) {
+            carries[merges.root(c) as usize] = true;
+        }
+    }
+    let mut candidates: Vec<(f64, MergedTurn)> = Vec::new();
+    for f in 0..front.len() {
+        let cols = front.face_columns(f);
+        if !cols.iter().any(|&c| merges.is_merged(c)) || reshaped_otherwise[f] {
+            continue;
+        }
+        let Some(tri) = after(f) else { continue };
+        let on_ridge = tri.iter().all(|&c| carries[c as usize]) && !tri.iter().any(|&c| fan[c as usize]);
+        if !on_ridge || triangle_min_angle(at(tri[0]), at(tri[1]), at(tri[2])) >= POOR_ANGLE {
+            continue;
+        }
+        for i in 0..3 {
+            let (a, b, c) = (tri[i], tri[(i + 1) % 3], tri[(i + 2) % 3]);
+            let Some((g, other)) = faces_after_around(a)
+                .find(|&(g, t)| g != f && (0..3).any(|j| t[j] == b && t[(j + 1) % 3] == a))
+            else {
+                continue;
+            };
+            let Some(&d) = other.iter().find(|&&x| x != a && x != b) else { continue };
+            if reshaped_otherwise[g] || front.patch[g] != front.patch[f] || fan[d as usize] || c == d {
+                continue;
+            }
+            if faces_after_around(c).any(|(_, t)| t.contains(&d)) {
+                continue;
+            }
+            if let Some(old) = gain([a, b, c, d].map(at)) {
+                candidates.push((old, MergedTurn { faces: [f, g], columns: [a, b, c, d] }));
+            }
+        }
+    }
+    candidates.sort_by(|x, y| x.0.total_cmp(&y.0));
+    let mut used_column = vec![false; columns.len()];
+    let mut used_face = vec![false; front.len()];
+    let mut turns = Vec::new();
+    for (_, turn) in candidates {
+        let [f, g] = turn.faces;
+        if used_face[f] || used_face[g] || turn.columns.iter().any(|&c| used_column[c as usize]) {
+            continue;
+        }
+        let Some(cell) = turned_cell(&cells[f].1, &cells[g].1, turn.columns.map(|c| top[c as usize])) else {
+            continue;
+        };
+        if !is_valid(&cell) {
+            continue;
+        }
+        cells[f].1 = cell;
+        cells[g].1 = SlabCell::Empty;
+        used_face[f] = true;
+        used_face[g] = true;
+        for &c in &turn.columns {
+            used_column[c as usize] = true;
+        }
+        turns.push(turn);
+    }
+    turns
+}
+
+/// The union of the cells `first` and `second` under the tops `(a, b, c)` and `(b, a, d)` with
+/// the top diagonal turned to `(c, d)`; `None` unless the two cells share their lateral face
+/// over `(a, b)` (the union is then closed).
+fn turned_cell(first: &SlabCell, second: &SlabCell, [a, b, c, d]: [u32; 4]) -> Option<SlabCell> {
+    let mut faces = cell_faces(first)?;
+    faces.extend(cell_faces(second)?);
+    for old in [[a, b, c], [b, a, d]] {
+        let old = Polygon::dedup(&old)?;
+        let i = faces.iter().position(|f| f.same_cycle(&old))?;
+        faces.remove(i);
+    }
+    faces.extend(Polygon::dedup(&[c, a, d]));
+    faces.extend(Polygon::dedup(&[d, b, c]));
+    slab::remove_opposite_pairs(&mut faces);
+    slab::is_closed(&faces).then(|| cell_from_faces(faces))
+}
+
+/// The outward faces of a slab cell, `None` for an empty or flat one.
+fn cell_faces(cell: &SlabCell) -> Option<Vec<Polygon>> {
+    match cell {
+        SlabCell::Standard { kind, nodes } => Some(
+            kind.faces()
+                .iter()
+                .filter_map(|f| Polygon::dedup(&f.iter().map(|&i| nodes[i]).collect::<Vec<_>>()))
+                .collect(),
+        ),
+        SlabCell::Split { faces, .. } => Some(faces.clone()),
+        SlabCell::Empty | SlabCell::Flat => None,
+    }
+}
+
+/// Whether each column carries a column merged into it in an earlier slab.
+fn carrying_merged(columns: &Columns) -> Vec<bool> {
+    let mut carries = vec![false; columns.len()];
+    for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
+        carries[r as usize] = true;
+    }
+    carries
+}
+
+/// Whether each column is one of several of its wall vertex: a fan's, or one whose edges were
+/// split (the split columns take its wall vertex).
+fn sharing_a_wall_vertex(columns: &Columns) -> Vec<bool> {
+    let mut per_vertex = vec![0u32; columns.wall_vertex_count()];
+    for &v in &columns.wall_vertex {
+        per_vertex[v as usize] += 1;
+    }
+    columns.wall_vertex.iter().map(|&v| per_vertex[v as usize] > 1).collect()
+}
+
+/// Whether each column is a fan's: one of several columns its wall vertex started with.
+fn fan_columns(columns: &Columns) -> Vec<bool> {
+    let mut per_vertex = vec![0u32; columns.wall_vertex_count()];
+    let at_wall = |c: usize| columns.born_at[c] == 0;
+    for c in (0..columns.len()).filter(|&c| at_wall(c)) {
+        per_vertex[columns.wall_vertex[c] as usize] += 1;
+    }
+    (0..columns.len()).map(|c| at_wall(c) && per_vertex[columns.wall_vertex[c] as usize] > 1).collect()
+}
+
 /// Whether every face is no longer its wall triangle's shape because a column merged into one
 /// of its columns: it then spans other wall vertices (along a concave ridge, three columns on
 /// the ridge itself, a sliver that only a swap turns back into the front's shape). Faces with a
@@ -186,19 +350,12 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
 /// swapped pair's new edge can run under the pyramid that will cap a quad (fandisk: 12 stacks
 /// stopped).
 fn faces_reshaped_by_merges(columns: &Columns, front: &Front) -> Vec<bool> {
-    let mut carries = vec![false; columns.len()];
-    for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
-        carries[r as usize] = true;
-    }
-    let mut per_vertex = vec![0u32; columns.wall_vertex_count()];
-    for &v in &columns.wall_vertex {
-        per_vertex[v as usize] += 1;
-    }
-    let fan = |c: u32| per_vertex[columns.wall_vertex[c as usize] as usize] > 1;
+    let carries = carrying_merged(columns);
+    let fan = sharing_a_wall_vertex(columns);
     (0..front.len())
         .map(|f| {
             let cols = front.face_columns(f);
-            cols.iter().any(|&c| carries[c as usize]) && !cols.iter().any(|&c| fan(c))
+            cols.iter().any(|&c| carries[c as usize]) && !cols.iter().any(|&c| fan[c as usize])
         })
         .collect()
 }
@@ -298,19 +455,32 @@ mod tests {
         match swap_cell([0, 1, 2, 3], [10, 11, 12, 13], |_, _| None) {
             SlabCell::Split { faces, .. } => {
                 assert_eq!(faces.len(), 8);
-                let mut directed: Vec<(u32, u32)> = faces
-                    .iter()
-                    .flat_map(|p| {
-                        let n = p.nodes();
-                        (0..n.len()).map(move |i| (n[i], n[(i + 1) % n.len()]))
-                    })
-                    .collect();
-                directed.sort_unstable();
-                for &(x, y) in &directed {
-                    assert!(directed.binary_search(&(y, x)).is_ok(), "edge ({x}, {y}) unmatched: not closed");
-                }
+                assert!(slab::is_closed(&faces));
             }
             other => panic!("{other:?}"),
         }
+    }
+
+    /// The prisms over faces (0, 1, 2) and (1, 0, 3) (tops 10..13) turned over their shared
+    /// edge: one cell closed by the two bottoms, the four outer laterals and the turned tops.
+    #[test]
+    fn a_turned_pair_of_cells_is_their_union_under_the_new_diagonal() {
+        let prism = |bottom: [u32; 3]| {
+            let mut nodes = [0; 8];
+            nodes[..3].copy_from_slice(&bottom);
+            nodes[3..6].copy_from_slice(&bottom.map(|n| n + 10));
+            SlabCell::Standard { kind: crate::mesh::CellKind::Prism, nodes }
+        };
+        let (first, second) = (prism([0, 1, 2]), prism([1, 0, 3]));
+        let SlabCell::Split { faces, .. } = turned_cell(&first, &second, [10, 11, 12, 13]).unwrap() else {
+            panic!("a polyhedron to split")
+        };
+        assert_eq!(faces.len(), 8);
+        assert!(slab::is_closed(&faces));
+        let has = |t: [u32; 3]| faces.iter().any(|f| f.same_cycle(&Polygon::dedup(&t).unwrap()));
+        assert!(has([12, 10, 13]) && has([13, 11, 12]), "the turned tops");
+        assert!(!has([10, 11, 12]) && !has([11, 10, 13]), "no old top");
+        // Cells that do not share the lateral face over the edge are not turned.
+        assert!(turned_cell(&first, &prism([4, 5, 6]), [10, 11, 12, 13]).is_none());
     }
 }

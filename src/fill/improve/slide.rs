@@ -280,9 +280,9 @@ impl TetMesh {
 
     /// Move front point `v` where the worst tetrahedron at it is best and every cell outside
     /// the core at it stays valid: a column's top down its last step (as far as its reach and
-    /// the growth ratio allow, [`TetMesh::max_sink`]), a pyramid's apex where its height over
-    /// the quad stays in the size band (hill climbing, then back towards where it was until
-    /// its pyramid is valid). `None` when it may not move or no other place keeps them valid.
+    /// the growth ratio allow, [`TetMesh::max_sink`]), a pyramid's apex to its best place
+    /// (hill climbing) with its height over the quad brought into the size band, then back
+    /// towards where it was until its pyramid is valid. `None` when it may not move or no other place keeps them valid.
     pub fn move_front_point(&self, v: u32) -> Option<Change> {
         let slides = self.slides.as_ref()?;
         let ball = self.ball_of(v);
@@ -299,12 +299,11 @@ impl TetMesh {
                     .1
             }
             Freedom::Apex { centre, normal, height } => {
-                let in_band = |p: &DVec3| {
-                    let h = (*p - centre).dot(normal);
-                    h >= height / self.band && h <= height * self.band
-                };
+                // The best place, brought into the band of heights over the quad.
                 let (p, _) = self.best_position(&ball, v, here);
-                (0..4).map(|k| here.lerp(p, 0.5f64.powi(k))).filter(in_band).find(valid)?
+                let h = (p - centre).dot(normal);
+                let p = p + normal * (h.clamp(height / self.band, height * self.band) - h);
+                (0..4).map(|k| here.lerp(p, 0.5f64.powi(k))).find(valid)?
             }
         };
         Some(self.point_move(&ball, v, best))
