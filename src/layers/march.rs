@@ -1316,13 +1316,7 @@ fn commit_slab(
         columns.dir[c as usize] = dir;
         columns.scale[c as usize] = scale;
     }
-    let mut swapped = swap::commit(&reshape.swaps, plan, front);
-    for turn in &turns {
-        let [a, b, c, d] = turn.columns;
-        front.subdivide_face(turn.faces[0], &[vec![c, a, d]]);
-        front.subdivide_face(turn.faces[1], &[vec![d, b, c]]);
-    }
-    swapped += turns.len();
+    let swapped = swap::commit(&reshape.swaps, plan, front) + swap::commit_turns(&turns, front);
     let old_count = columns.len() as u32;
     let made = split::commit(splits, plan, &mid_node, k, columns, front, sizes);
     if plan.collapses > 0 {

@@ -411,12 +411,24 @@ pub(super) fn commit(swaps: &Swaps, plan: &SlabPlan, front: &mut Front) -> usize
     let active: Vec<usize> = swaps.active(plan).collect();
     for &s in &active {
         let swap = &swaps.swaps[s];
-        let [a, b, c, d] = swap.columns;
-        let [f, g] = swap.faces.map(|x| x as usize);
-        front.subdivide_face(f, &[vec![c, a, d]]);
-        front.subdivide_face(g, &[vec![d, b, c]]);
+        turn_faces(front, swap.faces.map(|x| x as usize), swap.columns);
     }
     active.len()
+}
+
+/// Turn the front faces of `turns` (made on the front before the slab's merges, which keep the
+/// survivors); the front's adjacency must be rebuilt after. Returns how many were made.
+pub(super) fn commit_turns(turns: &[MergedTurn], front: &mut Front) -> usize {
+    for turn in turns {
+        turn_faces(front, turn.faces, turn.columns);
+    }
+    turns.len()
+}
+
+/// Faces `f = (a, b, c)` and `g = (b, a, d)` become `(c, a, d)` and `(d, b, c)`.
+fn turn_faces(front: &mut Front, [f, g]: [usize; 2], [a, b, c, d]: [u32; 4]) {
+    front.subdivide_face(f, &[vec![c, a, d]]);
+    front.subdivide_face(g, &[vec![d, b, c]]);
 }
 
 #[cfg(test)]

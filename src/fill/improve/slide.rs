@@ -282,7 +282,8 @@ impl TetMesh {
     /// the core at it stays valid: a column's top down its last step (as far as its reach and
     /// the growth ratio allow, [`TetMesh::max_sink`]), a pyramid's apex to its best place
     /// (hill climbing) with its height over the quad brought into the size band, then back
-    /// towards where it was until its pyramid is valid. `None` when it may not move or no other place keeps them valid.
+    /// towards where it was until its pyramid is valid. `None` when it may not move or no other
+    /// place keeps them valid.
     pub fn move_front_point(&self, v: u32) -> Option<Change> {
         let slides = self.slides.as_ref()?;
         let ball = self.ball_of(v);
