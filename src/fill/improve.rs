@@ -13,7 +13,6 @@
 //! smallest angle of the tetrahedra it replaces.
 
 use std::collections::{HashMap, HashSet};
-use std::sync::LazyLock;
 use std::time::Instant;
 
 use rayon::prelude::*;
@@ -25,7 +24,6 @@ use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::{triangle_area_vector, DVec3};
 use crate::mesh::{sorted_edge, CellKind};
-use crate::quality::measures::{dihedral_range, edge_face_pairs};
 
 pub use slide::{FrontSlides, MAX_SINK};
 
@@ -47,32 +45,43 @@ const WORST_FIRST_PASSES: usize = 3;
 /// Largest ring of tetrahedra around an edge that edge removal rebuilds.
 const MAX_RING: usize = 7;
 
-static TET_EDGE_FACES: LazyLock<Vec<(usize, usize)>> =
-    LazyLock::new(|| edge_face_pairs(CellKind::Tetrahedron));
-
 /// The six edges of a tetrahedron, as local node pairs.
 pub(crate) const TET_EDGES: [(usize, usize); 6] = [(0, 1), (0, 2), (0, 3), (1, 2), (1, 3), (2, 3)];
 
 /// Smallest dihedral angle of tetrahedron `x` in degrees; [`INVALID`] when it is not positive.
 pub fn min_dihedral(x: [DVec3; 4]) -> f64 {
-    dihedral_extremes(x).map_or(INVALID, |(lo, _)| lo)
+    dihedral_cosines(x).map_or(INVALID, |(most, _)| most.acos().to_degrees())
 }
 
 /// What the operators maximise: how far the dihedral angles of tetrahedron `x` stay from 0 and
 /// from 180 degrees (a cap, flat with an angle near 180, can have no small angle); [`INVALID`]
 /// when it is not positive.
 pub fn angle_quality(x: [DVec3; 4]) -> f64 {
-    dihedral_extremes(x).map_or(INVALID, |(lo, hi)| lo.min(180.0 - hi))
+    // min(angle, 180 - largest angle) is the arc cosine of the larger of the smallest angle's
+    // cosine and the negated largest angle's: one arc cosine per tetrahedron, the measure of
+    // every change the improvement weighs.
+    dihedral_cosines(x).map_or(INVALID, |(most, least)| most.max(-least).acos().to_degrees())
 }
 
-/// Smallest and largest dihedral angle of a positive tetrahedron, degrees.
-fn dihedral_extremes(x: [DVec3; 4]) -> Option<(f64, f64)> {
+/// The largest and smallest cosine of the dihedral angles of a positive tetrahedron (those of
+/// its smallest and largest angle); `None` when it is not positive. The faces' normals are
+/// the gradients of the barycentric coordinates, all pointing inward, so the angle at the edge
+/// two faces share has the negated cosine of the angle between their normals.
+fn dihedral_cosines(x: [DVec3; 4]) -> Option<(f64, f64)> {
     if orient3d(x[0], x[1], x[2], x[3]) != Sign::Positive {
         return None;
     }
-    let mut corners = [DVec3::ZERO; 8];
-    corners[..4].copy_from_slice(&x);
-    Some(dihedral_range(CellKind::Tetrahedron, &corners, &TET_EDGE_FACES))
+    let (e1, e2, e3) = (x[1] - x[0], x[2] - x[0], x[3] - x[0]);
+    let (g1, g2, g3) = (e2.cross(e3), e3.cross(e1), e1.cross(e2));
+    let normals = [-(g1 + g2 + g3), g1, g2, g3];
+    let inverse_length = normals.map(|n| n.length_recip());
+    let (mut most, mut least) = (f64::NEG_INFINITY, f64::INFINITY);
+    for (i, j) in TET_EDGES {
+        let cosine = (-normals[i].dot(normals[j]) * inverse_length[i] * inverse_length[j]).clamp(-1.0, 1.0);
+        most = most.max(cosine);
+        least = least.min(cosine);
+    }
+    Some((most, least))
 }
 
 /// How hard the improvement tries.

@@ -199,6 +199,23 @@ fn jittered_grid(n: usize, jitter: &[f64]) -> Option<TetMesh> {
 proptest! {
     #![proptest_config(ProptestConfig::with_cases(24))]
 
+    /// The tetrahedron's own dihedral measures equal the checker's, computed from each face's
+    /// normal by its definition.
+    #[test]
+    fn tetrahedron_angles_equal_the_checkers(raw in proptest::array::uniform12(-1.0f64..1.0)) {
+        let x: [DVec3; 4] = std::array::from_fn(|i| DVec3::new(raw[3 * i], raw[3 * i + 1], raw[3 * i + 2]));
+        let mut corners = [DVec3::ZERO; 8];
+        corners[..4].copy_from_slice(&x);
+        let pairs = crate::quality::measures::edge_face_pairs(CellKind::Tetrahedron);
+        let (lo, hi) = crate::quality::measures::dihedral_range(CellKind::Tetrahedron, &corners, &pairs);
+        if tet_signed_volume(x[0], x[1], x[2], x[3]) > 1e-6 {
+            prop_assert!((min_dihedral(x) - lo).abs() < 1e-6, "{} {}", min_dihedral(x), lo);
+            prop_assert!((angle_quality(x) - lo.min(180.0 - hi)).abs() < 1e-6);
+        } else if tet_signed_volume(x[0], x[1], x[2], x[3]) < 0.0 {
+            prop_assert_eq!(min_dihedral(x), INVALID);
+        }
+    }
+
     /// Any sequence of operators (point insertion at each of its places, the centroid among
     /// them, too) on a jittered grid keeps the mesh valid, conforming, with the
     /// same boundary and volume.
