@@ -303,8 +303,9 @@ impl LayersAndCore<'_> {
     /// [`PEEL_MAX_SLIVER_SHARE`] of the front's nodes), march again with the stacks under their
     /// front nodes a layer lower: the core there had no room for a good tetrahedron (fronts
     /// meeting head on in a crevice, a crumpled front), and one layer less gives it room. At
-    /// most `peel_rounds` more marches; the round with the fewest slivers (then the best worst
-    /// angle) is kept.
+    /// most `peel_rounds` more marches, and none after [`PEEL_PATIENCE`] rounds in a row that
+    /// did not beat the best; the round with the fewest slivers (then the best worst angle) is
+    /// kept.
     fn run_peeling(&self, timings: &mut Timings) -> Result<(Round, PeelStats), MeshError> {
         let mut caps = vec![u32::MAX; self.surface.points.len()];
         let mut stats = PeelStats::default();
@@ -338,7 +339,7 @@ impl LayersAndCore<'_> {
                 kept_caps = capped_now;
                 best = Some(this);
             }
-            if lowered == 0 {
+            if lowered == 0 || round - stats.kept_round >= PEEL_PATIENCE {
                 break;
             }
         }
@@ -401,6 +402,11 @@ impl LayersAndCore<'_> {
         Ok(Round { layered, mesh, core: Some(stats), slivers })
     }
 }
+
+/// Rounds in a row without a new best after which peeling stops: there the front does not
+/// settle, each lower cap only moves the slivers elsewhere, and every round re-runs the march
+/// and the whole core.
+const PEEL_PATIENCE: usize = 3;
 
 /// The most slivers, as a share of the front's nodes, that peeling tries to mend: more come
 /// from elsewhere (a wall faceted too coarsely for its layers: the elbow, wtc2), and peeling
