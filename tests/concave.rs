@@ -6,7 +6,7 @@ mod common;
 use blmesh::config::{Config, LayerCount, LayerSettings};
 use blmesh::geometry::distance::closest_point_on_triangle;
 use blmesh::layers::TOP_PATCH;
-use blmesh::pipeline::{run, MeshOptions, MeshOutput};
+use blmesh::pipeline::{run, LayerSummary, MeshOptions, MeshOutput};
 use blmesh::progress::Progress;
 use blmesh::surface::family::{family_body_at, Family};
 use blmesh::surface::{shapes, Surface};
@@ -69,6 +69,17 @@ fn offset_error(surface: &Surface, out: &MeshOutput, thickness: f64) -> f64 {
             (d - thickness).abs() / thickness
         })
         .fold(0.0, f64::max)
+}
+
+/// At least `share` of the wall vertices near concave ridges keep their full stack.
+fn assert_near_concave(name: &str, layers: &LayerSummary, share: f64) {
+    assert!(
+        layers.near_concave_coverage >= share,
+        "{name}: near-concave full stacks {:.1}% of {}, {} stopped",
+        100.0 * layers.near_concave_coverage,
+        layers.near_concave_vertices,
+        layers.stopped_vertices
+    );
 }
 
 fn assert_full_coverage(name: &str, out: &MeshOutput) {
@@ -195,11 +206,7 @@ fn cutcube_fandisk_flange_and_arrow_keep_their_layers_at_the_concave_ridges() {
             "{name}: full {:.4}, near concave {:.4} of {}, {} stopped early",
             l.full_coverage, l.near_concave_coverage, l.near_concave_vertices, l.stopped_vertices
         );
-        assert!(
-            l.near_concave_coverage >= near_concave,
-            "{name}: near concave ridges {:.4}",
-            l.near_concave_coverage
-        );
+        assert_near_concave(name, l, near_concave);
         assert!(l.full_coverage >= full, "{name}: full stacks at {:.4} of the wall", l.full_coverage);
     }
 }
@@ -337,12 +344,7 @@ fn slivers_that_merges_leave_along_a_wing_root_are_swapped_away() {
     let layers = &out.report.layers;
     common::assert_valid_for_a_solver("family wing-plate 2", &out.report.check);
     assert!(layers.march.swaps > 0, "the root's slivers must be swapped");
-    assert!(
-        layers.near_concave_coverage >= 0.8,
-        "near-concave full stacks {:.1}%, {} stopped",
-        100.0 * layers.near_concave_coverage,
-        layers.stopped_vertices
-    );
+    assert_near_concave("family wing-plate 2", layers, 0.8);
 }
 
 /// A post on a plate of the randomised family (seed 0) at the families' spec, at the defaults
@@ -361,12 +363,7 @@ fn slivers_that_merges_leave_at_a_post_foot_are_turned_in_their_slab() {
     let report = &out.report;
     common::assert_valid_for_a_solver("family post-plate 0", &report.check);
     assert!(report.layers.march.swaps > 0, "the foot's slivers must be turned");
-    assert!(
-        report.layers.near_concave_coverage >= 0.95,
-        "near-concave full stacks {:.1}%, {} stopped",
-        100.0 * report.layers.near_concave_coverage,
-        report.layers.stopped_vertices
-    );
+    assert_near_concave("family post-plate 0", &report.layers, 0.95);
     let core = report.core.as_ref().expect("a core");
     assert!(core.min_dihedral >= 10.0, "core minimum dihedral {:.2} deg", core.min_dihedral);
 }
