@@ -208,10 +208,11 @@ proptest! {
         corners[..4].copy_from_slice(&x);
         let pairs = crate::quality::measures::edge_face_pairs(CellKind::Tetrahedron);
         let (lo, hi) = crate::quality::measures::dihedral_range(CellKind::Tetrahedron, &corners, &pairs);
-        if tet_signed_volume(x[0], x[1], x[2], x[3]) > 1e-6 {
+        let volume = tet_signed_volume(x[0], x[1], x[2], x[3]);
+        if volume > 1e-6 {
             prop_assert!((min_dihedral(x) - lo).abs() < 1e-6, "{} {}", min_dihedral(x), lo);
             prop_assert!((angle_quality(x) - lo.min(180.0 - hi)).abs() < 1e-6);
-        } else if tet_signed_volume(x[0], x[1], x[2], x[3]) < 0.0 {
+        } else if volume < 0.0 {
             prop_assert_eq!(min_dihedral(x), INVALID);
         }
     }
