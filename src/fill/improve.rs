@@ -27,6 +27,14 @@ use crate::mesh::{sorted_edge, CellKind};
 
 pub use slide::{FrontSlides, MAX_SINK};
 
+/// No tetrahedron (across a boundary face).
+const NO_TET: u32 = u32::MAX;
+
+/// The local index of the node of `tet` that is not on its face `face`.
+fn opposite_node(tet: [u32; 4], face: [u32; 3]) -> usize {
+    (0..4).find(|&i| !face.contains(&tet[i])).expect("a face of the tetrahedron")
+}
+
 /// Quality of a flat or inverted tetrahedron: below every real angle.
 const INVALID: f64 = -1.0;
 
@@ -189,11 +197,17 @@ pub struct TetMesh {
     alive: Vec<bool>,
     /// The live tetrahedra at every point.
     ball: Vec<Vec<u32>>,
+    /// The tetrahedron across the face opposite each node of every tetrahedron ([`NO_TET`] on
+    /// the boundary): the cavities of insertions walk faces far more often than changes are
+    /// applied.
+    adjacent: Vec<[u32; 4]>,
     /// Points below this index are on the boundary: they never move.
     fixed: usize,
     /// The last layer's height under every front triangle with a prism under it, and the band
     /// the first core tetrahedron's height over it is kept in ([`TetMesh::keep_front_match`]).
     front_height: HashMap<[u32; 3], f64>,
+    /// The points of the triangles of `front_height`: a face with another point is not one.
+    on_front: Vec<bool>,
     band: f64,
     /// The front points that may slide down their columns, with the cells outside the core at
     /// them ([`TetMesh::allow_front_slides`]); none: the boundary never moves.
@@ -215,17 +229,38 @@ impl TetMesh {
         }
         let alive = vec![true; tets.len()];
         let points_len = points.len();
-        TetMesh {
+        let mut mesh = TetMesh {
             points,
             tets,
             alive,
             ball,
+            adjacent: Vec::new(),
             fixed,
             front_height: HashMap::new(),
+            on_front: Vec::new(),
             band: f64::INFINITY,
             slides: None,
             applied: 0,
             touched: vec![0; points_len],
+        };
+        mesh.adjacent = vec![[NO_TET; 4]; mesh.tets.len()];
+        for t in 0..mesh.tets.len() as u32 {
+            mesh.link_faces(t);
+        }
+        mesh
+    }
+
+    /// Set the neighbours across the faces of live tetrahedron `t`, on both sides.
+    fn link_faces(&mut self, t: u32) {
+        let tet = self.tets[t as usize];
+        for i in 0..4 {
+            let face = [tet[(i + 1) % 4], tet[(i + 2) % 4], tet[(i + 3) % 4]];
+            let other = self.tets_with(&face).into_iter().find(|&s| s != t);
+            self.adjacent[t as usize][i] = other.unwrap_or(NO_TET);
+            if let Some(s) = other {
+                let opposite = opposite_node(self.tets[s as usize], face);
+                self.adjacent[s as usize][opposite] = t;
+            }
         }
     }
 
@@ -235,6 +270,10 @@ impl TetMesh {
     /// seeds gave the first core cells the last layer's height, and a flip or an insertion
     /// near the front would take it away.
     pub fn keep_front_match(&mut self, front_height: HashMap<[u32; 3], f64>, band: f64) {
+        self.on_front = vec![false; self.points.len()];
+        for v in front_height.keys().flatten() {
+            self.on_front[*v as usize] = true;
+        }
         self.front_height = front_height;
         self.band = band;
     }
@@ -248,7 +287,11 @@ impl TetMesh {
         };
         (0..4)
             .filter(|&apex| {
-                let key = sorted_triangle([tet[(apex + 1) % 4], tet[(apex + 2) % 4], tet[(apex + 3) % 4]]);
+                let face = [tet[(apex + 1) % 4], tet[(apex + 2) % 4], tet[(apex + 3) % 4]];
+                if !face.iter().all(|&v| self.on_front.get(v as usize).copied().unwrap_or(false)) {
+                    return false;
+                }
+                let key = sorted_triangle(face);
                 self.front_height.get(&key).is_some_and(|&h| {
                     let ratio = height_over(key.map(x), x(tet[apex])).abs() / h;
                     !(1.0 / self.band..=self.band).contains(&ratio)
@@ -461,13 +504,19 @@ impl TetMesh {
                 self.ball[v as usize].retain(|&s| s != t);
             }
         }
+        let first_new = self.tets.len() as u32;
         for &tet in &change.add {
             let t = self.tets.len() as u32;
             self.tets.push(tet);
             self.alive.push(true);
+            self.adjacent.push([NO_TET; 4]);
             for v in tet {
                 self.ball[v as usize].push(t);
             }
+        }
+        // Every face of the cavity is a face of a new tetrahedron: linking those links all.
+        for t in first_new..self.tets.len() as u32 {
+            self.link_faces(t);
         }
     }
 
@@ -785,12 +834,8 @@ impl TetMesh {
 
     /// The other tetrahedron on a face of `t` (none on the boundary).
     fn neighbour(&self, t: u32, face: [u32; 3]) -> Option<u32> {
-        // As `tets_with`, without collecting: insertions ask this for every face of a cavity.
-        let [first, rest @ ..] = face;
-        self.ball[first as usize]
-            .iter()
-            .copied()
-            .find(|&s| s != t && rest.iter().all(|v| self.tets[s as usize].contains(v)))
+        let other = self.adjacent[t as usize][opposite_node(self.tets[t as usize], face)];
+        (other != NO_TET).then_some(other)
     }
 
     /// The tetrahedron holding `p`, walking from `start` across the faces `p` lies beyond;

@@ -39,10 +39,22 @@ fn assert_consistent(mesh: &TetMesh, reference: &TetMesh) {
         assert_eq!(orient3d(a, b, c, d), Sign::Positive, "{tet:?}");
     }
     assert!(face_counts(mesh).values().all(|&n| n <= 2), "a face on more than two tetrahedra");
+    assert_adjacent(mesh);
     assert_eq!(boundary_faces(mesh), boundary_faces(reference));
     let (v, w) = (volume(mesh), volume(reference));
     assert!((v - w).abs() <= 1e-12 * w.abs(), "volume {v} vs {w}");
     assert_eq!(mesh.points[..mesh.fixed], reference.points[..reference.fixed]);
+}
+
+/// The neighbour the mesh keeps across every face of every live tetrahedron is the other live
+/// tetrahedron on that face (none on the boundary).
+fn assert_adjacent(mesh: &TetMesh) {
+    for t in (0..mesh.tets.len() as u32).filter(|&t| mesh.alive[t as usize]) {
+        for face in mesh.outward_faces(t) {
+            let others: Vec<u32> = mesh.tets_with(&face).into_iter().filter(|&s| s != t).collect();
+            assert_eq!(mesh.neighbour(t, face), others.first().copied(), "tetrahedron {t}, face {face:?}");
+        }
+    }
 }
 
 /// Tetrahedra around the edge from `bottom` to `top` (nodes 0 and 1) with a regular ring of
