@@ -825,7 +825,7 @@ fn stop_to_uncross(
     if !CrossingGuard::pair_crosses(plan, reshape, mesh, columns, front, f, g) {
         return Vec::new();
     }
-    tracing::debug!(face = f, other = g, at = ?wall_points(front, f, columns), "the new front crosses itself: stopping both faces' columns");
+    tracing::debug!(face = f, other = g, at = ?wall_points(front, f, columns), other_at = ?wall_points(front, g, columns), "the new front crosses itself: stopping both faces' columns");
     let mut stopped = plan.stop_all(front.face_columns(f).iter().copied());
     stopped.extend(plan.stop_all(front.face_columns(g).iter().copied()));
     stopped
