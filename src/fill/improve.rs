@@ -35,6 +35,11 @@ fn opposite_node(tet: [u32; 4], face: [u32; 3]) -> usize {
     (0..4).find(|&i| !face.contains(&tet[i])).expect("a face of the tetrahedron")
 }
 
+/// The face of `tet` opposite its node `i` (unoriented).
+fn face_opposite(tet: [u32; 4], i: usize) -> [u32; 3] {
+    [tet[(i + 1) % 4], tet[(i + 2) % 4], tet[(i + 3) % 4]]
+}
+
 /// Quality of a flat or inverted tetrahedron: below every real angle.
 const INVALID: f64 = -1.0;
 
@@ -254,7 +259,7 @@ impl TetMesh {
     fn link_faces(&mut self, t: u32) {
         let tet = self.tets[t as usize];
         for i in 0..4 {
-            let face = [tet[(i + 1) % 4], tet[(i + 2) % 4], tet[(i + 3) % 4]];
+            let face = face_opposite(tet, i);
             let other = self.tets_with(&face).into_iter().find(|&s| s != t);
             self.adjacent[t as usize][i] = other.unwrap_or(NO_TET);
             if let Some(s) = other {
@@ -287,7 +292,7 @@ impl TetMesh {
         };
         (0..4)
             .filter(|&apex| {
-                let face = [tet[(apex + 1) % 4], tet[(apex + 2) % 4], tet[(apex + 3) % 4]];
+                let face = face_opposite(tet, apex);
                 if !face.iter().all(|&v| self.on_front.get(v as usize).copied().unwrap_or(false)) {
                     return false;
                 }
