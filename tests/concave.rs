@@ -313,6 +313,16 @@ fn fronts_meeting_across_a_slot_leave_the_core_a_gap_it_can_fill() {
     assert!(core.min_dihedral >= 10.0, "core minimum dihedral {:.2} deg", core.min_dihedral);
 }
 
+/// The layers alone of a body of the randomised family at the families' spec (10 layers from
+/// 1e-3 of its diagonal, growth 1.2, the default transition layers).
+fn family_layers(family: Family, seed: u64) -> MeshOutput {
+    let surface = family_body_at(family, seed, 1.0);
+    let h0 = 1e-3 * surface.bounding_box().diagonal();
+    let mut config = layered_config(h0, 10);
+    config.layers.transition = None;
+    run(surface, &config, &MeshOptions { core: false }, Progress::hidden()).expect("meshes")
+}
+
 /// A groove of the randomised family (seed 2: 71 degrees, oblique to the block, one triangle
 /// from lip to bottom) at the families' spec: at layer 10 the walls' fronts have shrunk to a
 /// quarter of their width and the tangential collapses merged lip and bisector columns, which
@@ -320,13 +330,23 @@ fn fronts_meeting_across_a_slot_leave_the_core_a_gap_it_can_fill() {
 /// slab then stops because the front crosses itself is taken back.
 #[test]
 fn tangential_collapses_never_cost_a_groove_its_layers() {
-    let surface = family_body_at(Family::Grooves, 2, 1.0);
-    let h0 = 1e-3 * surface.bounding_box().diagonal();
-    let mut config = layered_config(h0, 10);
-    config.layers.transition = None;
-    let out = run(surface, &config, &MeshOptions { core: false }, Progress::hidden()).expect("meshes");
+    let out = family_layers(Family::Grooves, 2);
     assert!(out.report.layers.march.tangential_collapses > 0, "the groove's fronts must coarsen");
     assert_full_coverage("family groove 2", &out);
+}
+
+/// A groove of the randomised family (seed 15: oblique to the block, its mouth narrower than
+/// the layers are thick) at the families' spec, layers only: the walls' fronts merge into the
+/// bisector, which reaches the mouth as the lips' fans meet over it. Each lip's fan strip then
+/// rises from the crease the merges left, and the two close a V over it, a cusp of the exact
+/// front; the pyramids the core would stand on the strips' quads cross, and stopping both
+/// strips' columns left 37.2% of the vertices near the groove's bottom with their full stack.
+/// The V's columns merge into the crease instead.
+#[test]
+fn lip_fans_meeting_over_a_filled_groove_merge_into_its_crease() {
+    let out = family_layers(Family::Grooves, 15);
+    common::assert_valid_for_a_solver("family groove 15", &out.report.check);
+    assert_near_concave("family groove 15", &out.report.layers, 0.7);
 }
 
 /// A wing on a plate of the randomised family (seed 2) at the families' spec, layers only: where

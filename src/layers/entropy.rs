@@ -21,14 +21,18 @@
 //! Fronts also meet with no ridge between them (a step lower than the layers are thick, a fin's
 //! edge at a body, a concave valley): a column whose top falls behind its layer's distance from
 //! the wall (a BVH over the walls with layers) merges into a neighbour on time
-//! ([`merge_overtaken`]). Last, before a cell's columns stop, a merge along one of its edges
-//! that leaves every cell around valid mends it ([`merge_to_mend`]).
+//! ([`merge_overtaken`]). Before a cell's columns stop, a merge along one of its edges
+//! that leaves every cell around valid mends it ([`merge_to_mend`]). Last, two faces whose tops
+//! cross over a front edge they share (two fronts closing a V over the crease where they met,
+//! as a groove's lip fans do over its filled mouth) merge their columns into the crease instead
+//! of stopping ([`merge_into_crease`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
+use super::slab::Polygon;
 use crate::geometry::distance::closest_point_on_triangle;
 use crate::sizing::wall::WallDistance;
 use crate::surface::topology::Topology;
@@ -761,6 +765,112 @@ pub(super) fn merge_to_mend(
     None
 }
 
+/// Where two faces whose tops cross share a front edge after the merges, fronts from two walls
+/// met along that edge and close a V over it (the crease of a groove whose mouth the layers
+/// fill: each lip's fan strip rises from the crease, and the exact fronts meet there at a cusp,
+/// nearly closed right after they meet). The V's columns on both sides of each end of that edge
+/// meet there: they merge into the edge's column, whose top goes to the middle of theirs (on the
+/// medial surface, where the fronts cross next), when that uncrosses the two faces (`crosses`)
+/// and leaves every cell around valid. Returns the columns whose tops moved, or `None` (the
+/// plan as it was) where the faces share no edge or the merge does not help.
+pub(super) fn merge_into_crease(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    (f, g): (usize, usize),
+    crosses: &impl Fn(&SlabPlan) -> bool,
+    invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
+) -> Option<Vec<u32>> {
+    let (pf, pg) = (plan.merges.resolved_face(front, f)?, plan.merges.resolved_face(front, g)?);
+    let crease = shared_edge(pf.nodes(), pg.nodes())?;
+    // Each corner of a face off the crease, with the end of the crease beside it (the nearer
+    // one for a triangle's apex).
+    let off_crease = |p: &Polygon| -> Vec<(u32, u32)> {
+        let n = p.nodes();
+        let top = |c: u32| plan.proposed[c as usize];
+        (0..n.len())
+            .filter(|&i| !crease.contains(&n[i]))
+            .filter_map(|i| {
+                let beside = [n[(i + 1) % n.len()], n[(i + n.len() - 1) % n.len()]];
+                let near = |r: &u32| top(*r).distance_squared(top(n[i]));
+                let r = beside
+                    .into_iter()
+                    .filter(|r| crease.contains(r))
+                    .min_by(|a, b| near(a).total_cmp(&near(b)))?;
+                Some((n[i], r))
+            })
+            .collect()
+    };
+    let (sides_f, sides_g) = (off_crease(&pf), off_crease(&pg));
+    let saved = plan.clone();
+    let mut changed = Vec::new();
+    // Each end of the crease that merges, its top, and the middle of the V's tops beside it.
+    let mut meetings: Vec<(u32, DVec3, DVec3)> = Vec::new();
+    for r in crease {
+        let at_r =
+            |side: &[(u32, u32)]| -> Vec<u32> { side.iter().filter(|m| m.1 == r).map(|m| m.0).collect() };
+        let (a, b) = (at_r(&sides_f), at_r(&sides_g));
+        if a.is_empty() || b.is_empty() {
+            continue;
+        }
+        let meeting: Vec<u32> = a.into_iter().chain(b).collect();
+        let middle = meeting.iter().map(|&c| plan.proposed[c as usize]).sum::<DVec3>() / meeting.len() as f64;
+        meetings.push((r, plan.proposed[r as usize], middle));
+        for c in meeting {
+            if !can_merge(plan, front, columns, r, c) {
+                *plan = saved;
+                return None;
+            }
+            merge_as(plan, columns, (r, c, false));
+            changed.push(c);
+        }
+        changed.push(r);
+    }
+    if meetings.is_empty() {
+        *plan = saved;
+        return None;
+    }
+    // Every column whose top moved: the crease's columns carry the tops of those merged into
+    // them before.
+    let mut group: Vec<u32> = changed.iter().flat_map(|&c| plan.merges.group(plan.merges.root(c))).collect();
+    group.sort_unstable();
+    group.dedup();
+    // The highest meeting point, from the middle of the V down to the crease's top, that keeps
+    // every cell valid: the crease's column carries cells below it that a jump up turns over,
+    // the V's columns fan cells that a drop onto the crease does.
+    for part in MEETING_HEIGHTS {
+        for &(r, crease_top, middle) in &meetings {
+            plan.proposed[r as usize] = columns.slide[r as usize].project(crease_top.lerp(middle, part));
+        }
+        if !crosses(plan) && invalid_cells(plan, &group) == 0 {
+            tracing::debug!(
+                f,
+                g,
+                ?changed,
+                part,
+                "crossing faces over a shared edge: merged into the crease"
+            );
+            return Some(group);
+        }
+    }
+    *plan = saved;
+    None
+}
+
+/// Where a V's columns merging into its crease may meet, as parts of the way from the crease's
+/// top to the middle of the V's tops, tried in turn.
+const MEETING_HEIGHTS: [f64; 5] = [1.0, 0.75, 0.5, 0.25, 0.0];
+
+/// The edge two polygons share (consecutive in both), if any.
+fn shared_edge(a: &[u32], b: &[u32]) -> Option<[u32; 2]> {
+    (0..a.len()).map(|i| [a[i], a[(i + 1) % a.len()]]).find(|&[x, y]| {
+        (0..b.len()).any(|j| {
+            let (u, v) = (b[j], b[(j + 1) % b.len()]);
+            (u, v) == (x, y) || (u, v) == (y, x)
+        })
+    })
+}
+
 /// Which of roots `a` and `b` survives their merge, which goes, and whether the survivor
 /// moves to the middle: the bisector column (larger scale) survives; equals meet in the middle.
 fn survivor(columns: &Columns, a: u32, b: u32) -> (u32, u32, bool) {
@@ -1013,5 +1123,15 @@ mod tests {
         assert_eq!(shrink_ratio(a, b, a + up, b + up), 1.0);
         assert_eq!(shrink_ratio(a, b, a + up + 0.25 * DVec3::X, b + up - 0.25 * DVec3::X), 0.5);
         assert!(shrink_ratio(a, b, b + up, a + up) < 0.0);
+    }
+
+    #[test]
+    fn shared_edge_is_an_edge_of_both_polygons_either_way_round() {
+        // A quad and a triangle on the edge 2-3, the triangle running it the other way.
+        assert_eq!(shared_edge(&[1, 2, 3, 4], &[3, 2, 7]), Some([2, 3]));
+        assert_eq!(shared_edge(&[1, 2, 3, 4], &[4, 1, 9]), Some([4, 1]));
+        // Two corners in common that are not an edge of one of them (a quad's diagonal).
+        assert_eq!(shared_edge(&[1, 2, 3, 4], &[1, 3, 8]), None);
+        assert_eq!(shared_edge(&[1, 2, 3], &[4, 5, 6]), None);
     }
 }

@@ -793,8 +793,23 @@ fn settle_slab(
         }
         let crossings = guard.crossings(&plan, reshape, mesh, columns, front, &suspects);
         let mut changed = Vec::new();
+        let invalid_cells =
+            |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
         for (f, g) in crossings.pairs {
-            let stopped = stop_to_uncross(&mut plan, reshape, mesh, columns, front, f, g);
+            // An earlier stop or merge may have uncrossed them (fronts meeting head on across a
+            // gap both stop, at the medial surface).
+            let crosses =
+                |plan: &SlabPlan| CrossingGuard::pair_crosses(plan, reshape, mesh, columns, front, f, g);
+            if !crosses(&plan) {
+                continue;
+            }
+            if let Some(merged) =
+                entropy::merge_into_crease(&mut plan, front, columns, (f, g), &crosses, &invalid_cells)
+            {
+                changed.extend(merged);
+                continue;
+            }
+            let stopped = stop_to_uncross(&mut plan, front, columns, f, g);
             plan.uncrossed.extend(&stopped);
             changed.extend(stopped);
         }
@@ -810,21 +825,8 @@ fn settle_slab(
     }
 }
 
-/// Stop the columns of the crossing faces `f` and `g`, unless an earlier stop uncrossed them
-/// (fronts meeting head on across a gap both stop, at the medial surface). Returns the columns
-/// that stopped.
-fn stop_to_uncross(
-    plan: &mut SlabPlan,
-    reshape: &Reshape,
-    mesh: &VolumeMesh,
-    columns: &Columns,
-    front: &Front,
-    f: usize,
-    g: usize,
-) -> Vec<u32> {
-    if !CrossingGuard::pair_crosses(plan, reshape, mesh, columns, front, f, g) {
-        return Vec::new();
-    }
+/// Stop the columns of the crossing faces `f` and `g`. Returns the columns that stopped.
+fn stop_to_uncross(plan: &mut SlabPlan, front: &Front, columns: &Columns, f: usize, g: usize) -> Vec<u32> {
     tracing::debug!(face = f, other = g, at = ?wall_points(front, f, columns), other_at = ?wall_points(front, g, columns), "the new front crosses itself: stopping both faces' columns");
     let mut stopped = plan.stop_all(front.face_columns(f).iter().copied());
     stopped.extend(plan.stop_all(front.face_columns(g).iter().copied()));
