@@ -203,10 +203,14 @@ pub(super) fn merge_bisector_crossings(
     walls: &VertexWalls,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) {
+    // A column passes only the bisectors of neighbours with a larger scale by RIDGE_SCALE
+    // ([`passed_bisectors`]): none beyond the largest scale of all.
+    let largest_scale = columns.scale.iter().copied().fold(0.0, f64::max);
     loop {
         let mut merged = false;
         for c in 0..columns.len() as u32 {
-            if !plan.moving[c as usize] || plan.merges.is_merged(c) {
+            let below_a_ridge = columns.scale[c as usize] * RIDGE_SCALE <= largest_scale;
+            if !plan.moving[c as usize] || plan.merges.is_merged(c) || !below_a_ridge {
                 continue;
             }
             // The nearest bisector it has passed (one ridge column beside another may see the
