@@ -372,9 +372,9 @@ pub(super) fn merge_flat_tops(
     k: u32,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) -> usize {
-    let mut merged = 0;
-    for f in 0..front.len() {
-        let Some(face) = plan.merges.resolved_face(front, f) else { continue };
+    // The faces of `plan` left flat along a line, with their columns' roots.
+    let flat_along_a_line = |plan: &SlabPlan, f: usize| {
+        let face = plan.merges.resolved_face(front, f)?;
         let n = face.nodes();
         // A column that does not move has no proposed top. Above the full stacks (layer `k`
         // past a full count) a flat face is most often a front closing on itself at a medial
@@ -383,10 +383,10 @@ pub(super) fn merge_flat_tops(
         let moving = front.face_columns(f).iter().all(|&c| plan.moving[c as usize]);
         let in_stack = n.iter().all(|&c| columns.full_count(c as usize).is_some_and(|t| k <= t));
         if n.len() < 3 || !moving || !in_stack {
-            continue;
+            return None;
         }
         if !area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP) {
-            continue;
+            return None;
         }
         let top = |c: u32| plan.proposed[c as usize];
         // Flat along a line, not crushed to a point (the cells' repairs see to those).
@@ -394,9 +394,20 @@ pub(super) fn merge_flat_tops(
         let longest = |at: &dyn Fn(u32) -> DVec3| {
             (0..n.len()).map(|i| at(n[i]).distance(at(n[(i + 1) % n.len()]))).fold(0.0, f64::max)
         };
-        if longest(&top) < LINE_LIKE * longest(&bottom) {
+        (longest(&top) >= LINE_LIKE * longest(&bottom)).then_some(face)
+    };
+    // Seen for every face in parallel under the plan as it comes; once a merge changed it, face
+    // by face (a merge tried and undone leaves the plan as it was).
+    let flat_at_first: Vec<bool> =
+        (0..front.len()).into_par_iter().map(|f| flat_along_a_line(plan, f).is_some()).collect();
+    let mut merged = 0;
+    for f in 0..front.len() {
+        if merged == 0 && !flat_at_first[f] {
             continue;
         }
+        let Some(face) = flat_along_a_line(plan, f) else { continue };
+        let n = face.nodes();
+        let top = |c: u32| plan.proposed[c as usize];
         let mut edges: Vec<(f64, u32, u32)> = (0..n.len())
             .map(|i| (n[i], n[(i + 1) % n.len()]))
             .filter(|&(a, b)| can_merge(plan, front, columns, a, b))
