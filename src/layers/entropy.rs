@@ -401,8 +401,8 @@ pub(super) fn merge_flat_tops(
     let flat_at_first: Vec<bool> =
         (0..front.len()).into_par_iter().map(|f| flat_along_a_line(plan, f).is_some()).collect();
     let mut merged = 0;
-    for f in 0..front.len() {
-        if merged == 0 && !flat_at_first[f] {
+    for (f, flat_at_first) in flat_at_first.into_iter().enumerate() {
+        if merged == 0 && !flat_at_first {
             continue;
         }
         let Some(face) = flat_along_a_line(plan, f) else { continue };
