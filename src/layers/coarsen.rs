@@ -15,6 +15,8 @@
 
 use std::f64::consts::FRAC_1_SQRT_2;
 
+use rayon::prelude::*;
+
 use super::entropy;
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
@@ -56,12 +58,15 @@ pub(super) fn collapse_short_edges(
     let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
     let sizes = EdgeSizes { target: h, height: &height, user };
     let mut made = Vec::new();
+    // The short edges under the plan as it is: a round that collapses nothing leaves the plan
+    // as it was (a collapse that fails is undone), so its list stays the plan's.
+    let mut short = short_edges(plan, front, columns, &sizes);
     for _ in 0..MAX_ROUNDS {
-        let mut short = short_edges(plan, front, columns, &sizes);
-        short.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
+        let mut shortest_first = short.clone();
+        shortest_first.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         let mut touched = vec![false; columns.len()];
         let before = made.len();
-        for (_, a, b) in short {
+        for (_, a, b) in shortest_first {
             if touched[a as usize]
                 || touched[b as usize]
                 || vetoed.contains(&(a, b))
@@ -78,12 +83,10 @@ pub(super) fn collapse_short_edges(
         if made.len() == before {
             break;
         }
+        short = short_edges(plan, front, columns, &sizes);
     }
-    let crushed = short_edges(plan, front, columns, &sizes)
-        .into_iter()
-        .filter(|&(length, _, _)| length < CRUSHED_LENGTH)
-        .map(|(_, a, b)| (a, b))
-        .collect();
+    let crushed =
+        short.into_iter().filter(|&(length, _, _)| length < CRUSHED_LENGTH).map(|(_, a, b)| (a, b)).collect();
     Coarsening { made, crushed }
 }
 
@@ -92,18 +95,28 @@ pub(super) fn collapse_short_edges(
 /// ([`EdgeSizes::collapse_length`]), each once; fan edges and edges between columns that slide
 /// differently are left out.
 fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, sizes: &EdgeSizes) -> Vec<(f64, u32, u32)> {
-    let root = |c: usize| plan.merges.root(c as u32) as usize;
-    let mut edges: Vec<(usize, usize)> =
-        front.edges().map(|(a, b)| (root(a), root(b))).filter(|&(a, b)| a < b).collect();
-    edges.sort_unstable();
-    edges.dedup();
-    edges
-        .into_iter()
-        .filter(|&(a, b)| plan.moving[a] && plan.moving[b])
-        .filter(|&(a, b)| !columns.is_fan_edge(a, b) && columns.slide[a] == columns.slide[b])
-        .filter_map(|(a, b)| {
-            let length = sizes.collapse_length(columns, a, b, plan.proposed[b] - plan.proposed[a]);
-            (length < COLLAPSE_LENGTH).then_some((length, a as u32, b as u32))
+    let root = |c: u32| plan.merges.root(c) as usize;
+    // Filtered by face in parallel, then ordered by their ends: the few short edges are all
+    // that is sorted (an edge's length depends only on its ends, so its copies are equal).
+    let mut short: Vec<(f64, u32, u32)> = (0..front.len())
+        .into_par_iter()
+        .flat_map_iter(|f| {
+            let cols = front.face_columns(f);
+            let n = cols.len();
+            (0..n).filter_map(move |i| {
+                let (a, b) = (root(cols[i]), root(cols[(i + 1) % n]));
+                let short = a < b
+                    && plan.moving[a]
+                    && plan.moving[b]
+                    && !columns.is_fan_edge(a, b)
+                    && columns.slide[a] == columns.slide[b];
+                let length = short
+                    .then(|| sizes.collapse_length(columns, a, b, plan.proposed[b] - plan.proposed[a]))?;
+                (length < COLLAPSE_LENGTH).then_some((length, a as u32, b as u32))
+            })
         })
-        .collect()
+        .collect();
+    short.sort_unstable_by_key(|&(_, a, b)| (a, b));
+    short.dedup_by_key(|&mut (_, a, b)| (a, b));
+    short
 }

@@ -207,10 +207,14 @@ pub(super) fn merge_bisector_crossings(
     walls: &VertexWalls,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) {
+    // A column passes only the bisectors of neighbours with a larger scale by RIDGE_SCALE
+    // ([`passed_bisectors`]): none beyond the largest scale of all.
+    let largest_scale = columns.scale.iter().copied().fold(0.0, f64::max);
     loop {
         let mut merged = false;
         for c in 0..columns.len() as u32 {
-            if !plan.moving[c as usize] || plan.merges.is_merged(c) {
+            let below_a_ridge = columns.scale[c as usize] * RIDGE_SCALE <= largest_scale;
+            if !plan.moving[c as usize] || plan.merges.is_merged(c) || !below_a_ridge {
                 continue;
             }
             // The nearest bisector it has passed (one ridge column beside another may see the
@@ -372,9 +376,9 @@ pub(super) fn merge_flat_tops(
     k: u32,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) -> usize {
-    let mut merged = 0;
-    for f in 0..front.len() {
-        let Some(face) = plan.merges.resolved_face(front, f) else { continue };
+    // The faces of `plan` left flat along a line, with their columns' roots.
+    let flat_along_a_line = |plan: &SlabPlan, f: usize| {
+        let face = plan.merges.resolved_face(front, f)?;
         let n = face.nodes();
         // A column that does not move has no proposed top. Above the full stacks (layer `k`
         // past a full count) a flat face is most often a front closing on itself at a medial
@@ -383,10 +387,10 @@ pub(super) fn merge_flat_tops(
         let moving = front.face_columns(f).iter().all(|&c| plan.moving[c as usize]);
         let in_stack = n.iter().all(|&c| columns.full_count(c as usize).is_some_and(|t| k <= t));
         if n.len() < 3 || !moving || !in_stack {
-            continue;
+            return None;
         }
         if !area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP) {
-            continue;
+            return None;
         }
         let top = |c: u32| plan.proposed[c as usize];
         // Flat along a line, not crushed to a point (the cells' repairs see to those).
@@ -394,9 +398,20 @@ pub(super) fn merge_flat_tops(
         let longest = |at: &dyn Fn(u32) -> DVec3| {
             (0..n.len()).map(|i| at(n[i]).distance(at(n[(i + 1) % n.len()]))).fold(0.0, f64::max)
         };
-        if longest(&top) < LINE_LIKE * longest(&bottom) {
+        (longest(&top) >= LINE_LIKE * longest(&bottom)).then_some(face)
+    };
+    // Seen for every face in parallel under the plan as it comes; once a merge changed it, face
+    // by face (a merge tried and undone leaves the plan as it was).
+    let flat_at_first: Vec<bool> =
+        (0..front.len()).into_par_iter().map(|f| flat_along_a_line(plan, f).is_some()).collect();
+    let mut merged = 0;
+    for (f, flat_at_first) in flat_at_first.into_iter().enumerate() {
+        if merged == 0 && !flat_at_first {
             continue;
         }
+        let Some(face) = flat_along_a_line(plan, f) else { continue };
+        let n = face.nodes();
+        let top = |c: u32| plan.proposed[c as usize];
         let mut edges: Vec<(f64, u32, u32)> = (0..n.len())
             .map(|i| (n[i], n[(i + 1) % n.len()]))
             .filter(|&(a, b)| can_merge(plan, front, columns, a, b))

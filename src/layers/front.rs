@@ -45,6 +45,9 @@ pub struct Columns {
     /// The layer the column starts at: 0 on the wall, the layer of its split for a column born
     /// by a split.
     pub born_at: Vec<u32>,
+    /// Whether another column is at the column's node, as the nodes were at the last
+    /// [`Columns::index_shared_nodes`] (see [`Columns::shares_node`]).
+    pub node_shared: Vec<bool>,
 }
 
 /// Where a new column starts and how it moves (see [`Columns::push`]).
@@ -123,6 +126,24 @@ impl Columns {
         self.spec.push(start.spec);
         self.born_at.push(start.layers);
         c
+    }
+
+    /// Record which columns are at the same node as another ([`Columns::shares_node`]); to be
+    /// called again whenever nodes change.
+    pub fn index_shared_nodes(&mut self) {
+        let size = self.node.iter().max().map_or(0, |&n| n as usize + 1);
+        let mut count = vec![0u8; size];
+        for &n in &self.node {
+            count[n as usize] = count[n as usize].saturating_add(1);
+        }
+        self.node_shared = self.node.iter().map(|&n| count[n as usize] > 1).collect();
+    }
+
+    /// Whether another column is at column `c`'s node (a fan's copies on the wall): as of the
+    /// last [`Columns::index_shared_nodes`], and `true` for columns added since or when the
+    /// nodes were never indexed.
+    pub fn shares_node(&self, c: usize) -> bool {
+        self.node_shared.get(c).is_none_or(|&shared| shared)
     }
 
     /// How far column `c` should be from the wall after `k` layers; `None` once its stack is

@@ -36,6 +36,10 @@ const TURNED: f64 = std::f64::consts::FRAC_1_SQRT_2;
 pub(super) struct CrossingGuard {
     /// Face pairs `(f, g)`, `f < g`, whose swept boxes overlap.
     pairs: Vec<(u32, u32)>,
+    /// The triangles `(f, g)` sharing one column whose columns point apart by more than
+    /// [`TURNED`] seen from `f`, by `f` ([`turned_pairs`]): they hold while the pairs do (the
+    /// front's faces and the columns' directions change only where the pairs are rebuilt).
+    turned: Vec<(u32, u32)>,
     /// The last layer the pairs hold for; `None` before the first build and after the front
     /// changed (collapses, redirected columns).
     valid_through: Option<u32>,
@@ -113,6 +117,7 @@ impl CrossingGuard {
             a.len() == 4 || b.len() == 4 || !a.iter().any(|c| b.contains(c))
         };
         self.pairs = overlapping_pairs_where(&boxes, &moving, keep);
+        self.turned = turned_pairs(front, columns);
         self.valid_through = Some(reach.through_layer);
         self.collapses_at_build = plan.collapses;
         self.rebuilds += 1;
@@ -142,7 +147,7 @@ impl CrossingGuard {
             .pairs
             .par_iter()
             .copied()
-            .chain(pairs_at_changes(plan, reshape, front, columns, suspects).into_par_iter())
+            .chain(pairs_at_changes(plan, reshape, front, &self.turned, suspects).into_par_iter())
             .filter(|&(f, g)| {
                 (suspect[f as usize] || suspect[g as usize]) && boxes[f as usize].overlaps(&boxes[g as usize])
             })
@@ -223,23 +228,18 @@ fn trace_crossing_pairs(front: &Front, columns: &Columns, pairs: impl Iterator<I
 
 /// The pairs of triangles sharing a column but no edge where one of them changes shape this
 /// slab (a column of it stops while another moves, merges, or has a split on its edge), among
-/// the `suspects`, or whose columns point apart by more than [`TURNED`]. A front moving as a
-/// whole cannot fold over a shared vertex without turning a cell between them inside out unless
-/// it turns sharply there (a hole a few edges round, whose fronts meet on its axis: flange); where
-/// columns stop at different layers or merge, thin triangles can, with every cell valid, so these
-/// pairs are tested beyond their shared vertex.
+/// the `suspects`, or whose columns point apart by more than [`TURNED`] (`turned`, from
+/// [`turned_pairs`]). A front moving as a whole cannot fold over a shared vertex without turning
+/// a cell between them inside out unless it turns sharply there (a hole a few edges round, whose
+/// fronts meet on its axis: flange); where columns stop at different layers or merge, thin
+/// triangles can, with every cell valid, so these pairs are tested beyond their shared vertex.
 fn pairs_at_changes(
     plan: &SlabPlan,
     reshape: &Reshape,
     front: &Front,
-    columns: &Columns,
+    turned: &[(u32, u32)],
     suspects: &[usize],
 ) -> Vec<(u32, u32)> {
-    let direction = |f: usize| front.face_columns(f).iter().map(|&c| columns.dir[c as usize]).sum::<DVec3>();
-    let turned = |f: usize, g: usize| {
-        let (a, b) = (direction(f), direction(g));
-        a.dot(b) < TURNED * a.length() * b.length()
-    };
     let changes = |f: usize| {
         let cols = front.face_columns(f);
         let moving = |c: u32| plan.moving[plan.merges.root(c) as usize];
@@ -250,28 +250,51 @@ fn pairs_at_changes(
             || reshape.splits.active_on_face(f, plan).is_some()
             || reshape.swaps.role(f, plan).is_some()
     };
+    let turned_from = |f: usize| {
+        let f = f as u32;
+        let first = turned.partition_point(|&(t, _)| t < f);
+        turned[first..].iter().take_while(move |&&(t, _)| t == f).map(|&(_, g)| g as usize)
+    };
     let mut pairs: Vec<(u32, u32)> = suspects
         .par_iter()
         .copied()
         .filter(|&f| front.face_columns(f).len() == 3)
         .flat_map_iter(|f| {
-            let cols = front.face_columns(f);
             let changed = changes(f);
-            cols.iter()
-                .flat_map(move |&c| front.faces_of(c))
-                .filter(move |&g| {
-                    let other = front.face_columns(g);
-                    g != f
-                        && other.len() == 3
-                        && other.iter().filter(|c| cols.contains(c)).count() == 1
-                        && (changed || turned(f, g))
-                })
-                .map(move |g| (f.min(g) as u32, f.max(g) as u32))
+            let all = changed.then(|| vertex_neighbours(front, f)).into_iter().flatten();
+            let turned = (!changed).then(|| turned_from(f)).into_iter().flatten();
+            all.chain(turned).map(move |g| (f.min(g) as u32, f.max(g) as u32))
         })
         .collect();
     pairs.par_sort_unstable();
     pairs.dedup();
     pairs
+}
+
+/// The triangles `(f, g)` sharing one column (no edge) whose columns' summed directions make a
+/// cosine below [`TURNED`], seen from `f`, in the order of `f`.
+fn turned_pairs(front: &Front, columns: &Columns) -> Vec<(u32, u32)> {
+    let direction = |f: usize| front.face_columns(f).iter().map(|&c| columns.dir[c as usize]).sum::<DVec3>();
+    let turned = |f: usize, g: usize| {
+        let (a, b) = (direction(f), direction(g));
+        a.dot(b) < TURNED * a.length() * b.length()
+    };
+    (0..front.len())
+        .into_par_iter()
+        .filter(|&f| front.face_columns(f).len() == 3)
+        .flat_map_iter(|f| {
+            vertex_neighbours(front, f).filter(move |&g| turned(f, g)).map(move |g| (f as u32, g as u32))
+        })
+        .collect()
+}
+
+/// The triangles sharing exactly one column with triangle `f`.
+fn vertex_neighbours(front: &Front, f: usize) -> impl Iterator<Item = usize> + '_ {
+    let cols = front.face_columns(f);
+    cols.iter().flat_map(move |&c| front.faces_of(c)).filter(move |&g| {
+        let other = front.face_columns(g);
+        g != f && other.len() == 3 && other.iter().filter(|c| cols.contains(c)).count() == 1
+    })
 }
 
 /// The proposed top of the front faces under a slab plan.

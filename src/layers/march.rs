@@ -305,6 +305,10 @@ fn lateral_cut(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32
 /// another column standing on `b`'s node and none on `a`'s (and the other way round). That
 /// holds only while the fan's copies stand together on the wall, in the first layer.
 fn fan_end_cut_from(front: &Front, columns: &Columns, a: u32, b: u32) -> Option<u32> {
+    // Only where a column stands on another's node (none once the fans have left the wall).
+    if !columns.shares_node(a as usize) && !columns.shares_node(b as usize) {
+        return None;
+    }
     let node = |c: u32| columns.node[c as usize];
     let (lo, hi) = if a < b { (a, b) } else { (b, a) };
     front.faces_of(lo).find_map(|f| {
@@ -463,6 +467,7 @@ pub fn march(
         if !columns.alive.iter().any(|&a| a) {
             break;
         }
+        columns.index_shared_nodes();
         let points = &mesh.points;
         let mut proposed: Vec<DVec3> = (0..columns.len())
             .into_par_iter()

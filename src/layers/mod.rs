@@ -21,6 +21,8 @@ pub mod unfold;
 
 use std::collections::HashMap;
 
+use rayon::prelude::*;
+
 use crate::config::LayerSpec;
 use crate::mesh::VolumeMesh;
 use crate::normals::constraint::Slide;
@@ -413,14 +415,23 @@ fn front_tops(
     faces: impl Iterator<Item = usize>,
 ) -> Vec<slab::Polygon> {
     let tops: Vec<slab::Polygon> = faces.filter_map(|f| top_polygon(front, columns, f)).collect();
-    let mut by_nodes: std::collections::HashMap<Vec<u32>, Vec<usize>> = std::collections::HashMap::new();
-    for (i, top) in tops.iter().enumerate() {
-        let mut key = top.nodes().to_vec();
-        key.sort_unstable();
-        by_nodes.entry(key).or_default().push(i);
-    }
+    // The tops by their sorted nodes (and count): those with the same nodes are together, in
+    // increasing order.
+    let mut by_nodes: Vec<((usize, [u32; 4]), usize)> = tops
+        .iter()
+        .enumerate()
+        .map(|(i, top)| {
+            let n = top.nodes();
+            let mut key = [0; 4];
+            key[..n.len()].copy_from_slice(n);
+            key[..n.len()].sort_unstable();
+            ((n.len(), key), i)
+        })
+        .collect();
+    by_nodes.par_sort_unstable();
     let mut keep = vec![true; tops.len()];
-    for same in by_nodes.values().filter(|v| v.len() > 1) {
+    for group in by_nodes.chunk_by(|x, y| x.0 == y.0).filter(|g| g.len() > 1) {
+        let same: Vec<usize> = group.iter().map(|&(_, i)| i).collect();
         for (n, &i) in same.iter().enumerate() {
             if let Some(&j) =
                 same[n + 1..].iter().find(|&&j| keep[i] && keep[j] && tops[j].is_reverse_of(&tops[i]))
@@ -436,8 +447,12 @@ fn front_tops(
 /// The top of front face `f` where the columns are now: its distinct nodes (a triangle or a
 /// quad; `None` when merges left fewer than three).
 fn top_polygon(front: &front::Front, columns: &front::Columns, f: usize) -> Option<slab::Polygon> {
-    let nodes: Vec<u32> = front.face_columns(f).iter().map(|&c| columns.node[c as usize]).collect();
-    slab::Polygon::dedup(&nodes)
+    let cols = front.face_columns(f);
+    let mut nodes = [0; 4];
+    for (n, &c) in nodes.iter_mut().zip(cols) {
+        *n = columns.node[c as usize];
+    }
+    slab::Polygon::dedup(&nodes[..cols.len()])
 }
 
 #[cfg(test)]

@@ -14,6 +14,7 @@
 //! their own (one stopped or merged) is not made.
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::front::{Columns, Front, NOT_MERGED};
 use super::march::SlabPlan;
@@ -114,45 +115,49 @@ impl Swaps {
 /// whose worst top angle is poor and would gain by the swap without folding; each column in one
 /// swap at most, the worst pairs first.
 pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], splits: &Splits) -> Swaps {
-    let mut candidates: Vec<(f64, Swap)> = Vec::new();
     let split_faces = splits.faces_with_splits(front.len());
     let reshaped = faces_reshaped_by_merges(columns, front);
-    for f in 0..front.len() {
-        let cols = front.face_columns(f);
-        if cols.len() != 3 || split_faces[f] || !cols.iter().all(|&c| columns.alive[c as usize]) {
-            continue;
-        }
-        // A pair gains only when one of its triangles is poor: most faces stop here (a pair
-        // is looked at from its poor face, so from both when both are).
-        let [p, q, r] = [0, 1, 2].map(|i| proposed[cols[i] as usize]);
-        if triangle_min_angle(p, q, r) >= POOR_ANGLE {
-            continue;
-        }
-        for i in 0..3 {
-            let (a, b, c) = (cols[i], cols[(i + 1) % 3], cols[(i + 2) % 3]);
-            let Some(g) = opposite_face(front, f, a, b) else { continue };
-            if split_faces[g] || front.patch[g] != front.patch[f] {
-                continue;
-            }
-            let other = front.face_columns(g);
-            let Some(&d) = other.iter().find(|&&x| x != a && x != b) else { continue };
-            let four = [a, b, c, d];
-            let usable =
-                |x: u32| columns.alive[x as usize] && columns.slide[x as usize] == columns.slide[a as usize];
-            if !four.iter().all(|&x| usable(x)) || c == d || front.are_neighbours(c, d) {
-                continue;
-            }
-            // The wall's own triangulation is the user's: only pairs a split made, or a merge
-            // reshaped, are swapped.
-            if four.iter().all(|&x| columns.born_at[x as usize] == 0) && !reshaped[f] {
-                continue;
-            }
-            let at = four.map(|x| proposed[x as usize]);
-            if let Some(old) = gain(at) {
-                candidates.push((old, Swap { faces: [f as u32, g as u32], columns: four, enabled: true }));
-            }
-        }
-    }
+    let (split_faces, reshaped) = (&split_faces, &reshaped);
+    // Looked for by face in parallel, in face order.
+    let mut candidates: Vec<(f64, Swap)> = (0..front.len())
+        .into_par_iter()
+        .flat_map_iter(|f| {
+            let cols = front.face_columns(f);
+            let looked_at =
+                cols.len() == 3 && !split_faces[f] && cols.iter().all(|&c| columns.alive[c as usize]);
+            // A pair gains only when one of its triangles is poor: most faces stop here (a pair
+            // is looked at from its poor face, so from both when both are).
+            let poor = looked_at
+                && triangle_min_angle(
+                    proposed[cols[0] as usize],
+                    proposed[cols[1] as usize],
+                    proposed[cols[2] as usize],
+                ) < POOR_ANGLE;
+            (0..if poor { 3 } else { 0 }).filter_map(move |i| {
+                let (a, b, c) = (cols[i], cols[(i + 1) % 3], cols[(i + 2) % 3]);
+                let g = opposite_face(front, f, a, b)?;
+                if split_faces[g] || front.patch[g] != front.patch[f] {
+                    return None;
+                }
+                let other = front.face_columns(g);
+                let &d = other.iter().find(|&&x| x != a && x != b)?;
+                let four = [a, b, c, d];
+                let usable = |x: u32| {
+                    columns.alive[x as usize] && columns.slide[x as usize] == columns.slide[a as usize]
+                };
+                if !four.iter().all(|&x| usable(x)) || c == d || front.are_neighbours(c, d) {
+                    return None;
+                }
+                // The wall's own triangulation is the user's: only pairs a split made, or a merge
+                // reshaped, are swapped.
+                if four.iter().all(|&x| columns.born_at[x as usize] == 0) && !reshaped[f] {
+                    return None;
+                }
+                let old = gain(four.map(|x| proposed[x as usize]))?;
+                Some((old, Swap { faces: [f as u32, g as u32], columns: four, enabled: true }))
+            })
+        })
+        .collect();
     candidates.sort_by(|x, y| x.0.total_cmp(&y.0));
     let mut swaps = Swaps::default();
     if candidates.is_empty() {

@@ -15,6 +15,7 @@
 use std::collections::HashMap;
 
 use glam::DVec3;
+use rayon::prelude::*;
 
 use super::front::{Columns, Front, NOT_MERGED};
 use super::guard::pyramid_apex;
@@ -22,7 +23,7 @@ use crate::geometry::{signed_turn_deg, triangle_max_angle};
 use crate::mesh::{sorted_edge, CellKind, VolumeMesh};
 use crate::normals::constraint::Slide;
 use crate::quality::validity::{cell_validity, gather};
-use crate::surface::topology::opposite_vertex;
+use crate::surface::topology::{group_by_key_with, opposite_vertex};
 use crate::surface::Surface;
 
 /// A front triangle whose largest angle is above this (degrees) is a cap...
@@ -65,36 +66,43 @@ struct CoreFront {
     quads: Vec<[u32; 4]>,
     /// The first apex's point.
     first_apex: usize,
-    /// For each node, the quads at it.
-    quads_at: HashMap<u32, Vec<u32>>,
-    /// For each node, the triangles at it.
-    at_node: HashMap<u32, Vec<u32>>,
-    /// For each edge (sorted), the triangles on it.
-    on_edge: HashMap<[u32; 2], Vec<u32>>,
+    /// For each node, the quads at it (CSR by node: offsets, quads).
+    quads_at: (Vec<u32>, Vec<u32>),
+    /// For each node, the triangles at it, in increasing order (CSR by node).
+    at_node: (Vec<u32>, Vec<u32>),
 }
 
 impl CoreFront {
-    /// `None` when a quad cannot be capped (the fill would fail there whatever moves).
+    /// `None` when a quad cannot be capped (the fill would fail there whatever moves). The
+    /// triangles' corners are distinct nodes (so are the tops [`final_front`] gives).
     fn new(mut points: Vec<DVec3>, mut triangles: Vec<[u32; 3]>, quads: Vec<[u32; 4]>) -> Option<CoreFront> {
         let first_apex = points.len();
-        let mut quads_at: HashMap<u32, Vec<u32>> = HashMap::new();
         for (q, quad) in quads.iter().enumerate() {
             points.push(pyramid_apex(quad.map(|n| points[n as usize]))?);
             let apex = (first_apex + q) as u32;
             for i in 0..4 {
                 triangles.push([quad[i], quad[(i + 1) % 4], apex]);
-                quads_at.entry(quad[i]).or_default().push(q as u32);
             }
         }
-        let mut at_node: HashMap<u32, Vec<u32>> = HashMap::new();
-        let mut on_edge: HashMap<[u32; 2], Vec<u32>> = HashMap::new();
-        for (t, tri) in triangles.iter().enumerate() {
-            for i in 0..3 {
-                at_node.entry(tri[i]).or_default().push(t as u32);
-                on_edge.entry(sorted_edge(tri[i], tri[(i + 1) % 3])).or_default().push(t as u32);
-            }
-        }
-        Some(CoreFront { points, triangles, quads, first_apex, quads_at, at_node, on_edge })
+        let by_node = |corners: &[u32], per_item: usize| {
+            let items: Vec<u32> = (0..corners.len()).map(|i| (i / per_item) as u32).collect();
+            group_by_key_with(corners, &items, points.len())
+        };
+        let quads_at = by_node(quads.as_flattened(), 4);
+        let at_node = by_node(triangles.as_flattened(), 3);
+        Some(CoreFront { points, triangles, quads, first_apex, quads_at, at_node })
+    }
+
+    /// The quads at node `v`.
+    fn quads_at(&self, v: u32) -> &[u32] {
+        let (start, quads) = &self.quads_at;
+        &quads[start[v as usize] as usize..start[v as usize + 1] as usize]
+    }
+
+    /// The triangles at node `v`, in increasing order.
+    fn triangles_at(&self, v: u32) -> &[u32] {
+        let (start, triangles) = &self.at_node;
+        &triangles[start[v as usize] as usize..start[v as usize + 1] as usize]
     }
 
     fn corners(&self, t: u32) -> [DVec3; 3] {
@@ -111,7 +119,7 @@ impl CoreFront {
     fn move_node(&mut self, v: u32, p: DVec3) -> bool {
         let old = self.points[v as usize];
         self.points[v as usize] = p;
-        let quads = self.quads_at.get(&v).cloned().unwrap_or_default();
+        let quads = self.quads_at(v).to_vec();
         let mut apexes = Vec::with_capacity(quads.len());
         for &q in &quads {
             match pyramid_apex(self.quads[q as usize].map(|n| self.points[n as usize])) {
@@ -130,12 +138,9 @@ impl CoreFront {
 
     /// The triangles a move of node `v` changes: those at it and at its quads' apexes.
     fn triangles_moved_by(&self, v: u32) -> Vec<u32> {
-        let apexes =
-            self.quads_at.get(&v).into_iter().flatten().map(|&q| (self.first_apex + q as usize) as u32);
-        let mut around: Vec<u32> = std::iter::once(v)
-            .chain(apexes)
-            .flat_map(|n| self.at_node.get(&n).into_iter().flatten().copied())
-            .collect();
+        let apexes = self.quads_at(v).iter().map(|&q| (self.first_apex + q as usize) as u32);
+        let mut around: Vec<u32> =
+            std::iter::once(v).chain(apexes).flat_map(|n| self.triangles_at(n).iter().copied()).collect();
         around.sort_unstable();
         around.dedup();
         around
@@ -159,7 +164,11 @@ impl CoreFront {
     /// the signed turn there (below 180 in a valley, near 0 at a fold); 180 for an edge with
     /// another number of triangles.
     fn core_angle(&self, edge: [u32; 2]) -> f64 {
-        let Some(&[s, t]) = self.on_edge.get(&edge).map(Vec::as_slice) else { return 180.0 };
+        let [a, b] = edge;
+        let mut on_edge = self.triangles_at(a).iter().filter(|&&t| self.triangles[t as usize].contains(&b));
+        let (Some(&s), Some(&t), None) = (on_edge.next(), on_edge.next(), on_edge.next()) else {
+            return 180.0;
+        };
         let far = opposite_vertex(self.triangles[t as usize], edge);
         180.0 + signed_turn_deg(self.corners(s), self.corners(t), self.points[far as usize])
     }
@@ -185,7 +194,7 @@ impl CoreFront {
     }
 
     fn defects(&self) -> usize {
-        (0..self.triangles.len() as u32).filter(|&t| self.is_defect(t)).count()
+        (0..self.triangles.len() as u32).into_par_iter().filter(|&t| self.is_defect(t)).count()
     }
 }
 

@@ -280,7 +280,7 @@ fn group_by_key(keys: &[u32], key_count: usize) -> (Vec<u32>, Vec<u32>) {
 }
 
 /// Counting sort of `items` by `keys` (stable): CSR `(start offsets, items)`.
-fn group_by_key_with(keys: &[u32], items: &[u32], key_count: usize) -> (Vec<u32>, Vec<u32>) {
+pub(crate) fn group_by_key_with(keys: &[u32], items: &[u32], key_count: usize) -> (Vec<u32>, Vec<u32>) {
     let mut start = vec![0u32; key_count + 1];
     for &k in keys {
         start[k as usize + 1] += 1;
