@@ -817,54 +817,48 @@ pub(super) fn merge_into_crease(
             .collect()
     };
     let (sides_f, sides_g) = (off_crease(&pf), off_crease(&pg));
+    // Each end of the crease where the V's columns from both faces meet: the end, those columns,
+    // its top and the middle of theirs.
+    let meetings: Vec<(u32, Vec<u32>, DVec3, DVec3)> = crease
+        .into_iter()
+        .filter_map(|r| {
+            let at_r =
+                |side: &[(u32, u32)]| side.iter().filter(|m| m.1 == r).map(|m| m.0).collect::<Vec<u32>>();
+            let (a, b) = (at_r(&sides_f), at_r(&sides_g));
+            if a.is_empty() || b.is_empty() {
+                return None;
+            }
+            let meeting: Vec<u32> = a.into_iter().chain(b).collect();
+            let middle =
+                meeting.iter().map(|&c| plan.proposed[c as usize]).sum::<DVec3>() / meeting.len() as f64;
+            Some((r, meeting, plan.proposed[r as usize], middle))
+        })
+        .collect();
+    if meetings.is_empty() {
+        return None;
+    }
     let saved = plan.clone();
-    let mut changed = Vec::new();
-    // Each end of the crease that merges, its top, and the middle of the V's tops beside it.
-    let mut meetings: Vec<(u32, DVec3, DVec3)> = Vec::new();
-    for r in crease {
-        let at_r =
-            |side: &[(u32, u32)]| -> Vec<u32> { side.iter().filter(|m| m.1 == r).map(|m| m.0).collect() };
-        let (a, b) = (at_r(&sides_f), at_r(&sides_g));
-        if a.is_empty() || b.is_empty() {
-            continue;
-        }
-        let meeting: Vec<u32> = a.into_iter().chain(b).collect();
-        let middle = meeting.iter().map(|&c| plan.proposed[c as usize]).sum::<DVec3>() / meeting.len() as f64;
-        meetings.push((r, plan.proposed[r as usize], middle));
-        for c in meeting {
-            if !can_merge(plan, front, columns, r, c) {
+    for (r, meeting, _, _) in &meetings {
+        for &c in meeting {
+            if !can_merge(plan, front, columns, *r, c) {
                 *plan = saved;
                 return None;
             }
-            merge_as(plan, columns, (r, c, false));
-            changed.push(c);
+            merge_as(plan, columns, (*r, c, false));
         }
-        changed.push(r);
     }
-    if meetings.is_empty() {
-        *plan = saved;
-        return None;
-    }
-    // Every column whose top moved: the crease's columns carry the tops of those merged into
-    // them before.
-    let mut group: Vec<u32> = changed.iter().flat_map(|&c| plan.merges.group(plan.merges.root(c))).collect();
-    group.sort_unstable();
-    group.dedup();
+    // Every column whose top moved: the crease's ends carry the tops of the columns merged into
+    // them, now and before.
+    let group: Vec<u32> = meetings.iter().flat_map(|m| plan.merges.group(m.0)).collect();
     // The highest meeting point, from the middle of the V down to the crease's top, that keeps
     // every cell valid: the crease's column carries cells below it that a jump up turns over,
     // the V's columns fan cells that a drop onto the crease does.
     for part in MEETING_HEIGHTS {
-        for &(r, crease_top, middle) in &meetings {
+        for &(r, _, crease_top, middle) in &meetings {
             plan.proposed[r as usize] = columns.slide[r as usize].project(crease_top.lerp(middle, part));
         }
         if !crosses(plan) && invalid_cells(plan, &group) == 0 {
-            tracing::debug!(
-                f,
-                g,
-                ?changed,
-                part,
-                "crossing faces over a shared edge: merged into the crease"
-            );
+            tracing::debug!(f, g, ?group, part, "crossing faces over a shared edge: merged into the crease");
             return Some(group);
         }
     }
