@@ -693,11 +693,12 @@ impl std::fmt::Display for MeshReport {
         )?;
         writeln!(
             f,
-            "normals   {} columns ({} in fans over {} convex ridge edges, {} corner patches)",
+            "normals   {} columns ({} in fans over {} convex ridge edges, {} corner patches, {} ridges carried to their roots)",
             self.normals.columns,
             self.normals.fan_columns,
             self.normals.fan_edges,
-            self.normals.corner_patches
+            self.normals.corner_patches,
+            self.normals.ridge_roots
         )?;
         match &self.core {
             Some(c) => {

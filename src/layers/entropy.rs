@@ -123,6 +123,9 @@ pub struct VertexWalls<'a> {
     layered: WallDistance,
     /// Every wall triangle's index in `layered` (`u32::MAX` for those without layers).
     layered_index: Vec<u32>,
+    /// Normals of the offset cylinders of ridges at their roots, by wall vertex
+    /// ([`WallNormals::cylinder_normals`](crate::normals::WallNormals::cylinder_normals)).
+    cylinders: Vec<(u32, DVec3)>,
 }
 
 impl<'a> VertexWalls<'a> {
@@ -142,12 +145,23 @@ impl<'a> VertexWalls<'a> {
             normals: (0..surface.triangles.len()).map(|t| surface.triangle_normal(t)).collect(),
             layered: WallDistance::new(&walls),
             layered_index,
+            cylinders: Vec::new(),
         }
     }
 
-    /// The normals at wall vertex `v` (none for a vertex off the surface).
+    /// With the offset cylinders of ridges at their roots as walls of their own (sorted by
+    /// vertex): a ridge's fan column there bisects its cylinder and the floor.
+    pub fn with_cylinders(mut self, cylinders: &[(u32, DVec3)]) -> Self {
+        self.cylinders = cylinders.to_vec();
+        self
+    }
+
+    /// The normals at wall vertex `v` (none for a vertex off the surface): its triangles', and
+    /// those of a ridge's offset cylinder where the ridge has its root at `v`.
     pub fn at(&self, v: u32) -> impl Iterator<Item = DVec3> + '_ {
-        self.triangles_at(v).iter().map(|&t| self.normals[t as usize])
+        let start = self.cylinders.partition_point(|&(x, _)| x < v);
+        let cylinders = self.cylinders[start..].iter().take_while(move |&&(x, _)| x == v).map(|&(_, n)| n);
+        self.triangles_at(v).iter().map(|&t| self.normals[t as usize]).chain(cylinders)
     }
 
     /// The wall triangles at wall vertex `v` (none for a vertex off the surface).

@@ -228,7 +228,8 @@ impl<'a> MarchStart<'a> {
         };
         let mut sizes =
             split::Sizes::new(self.adapt, front.mean_edge_length_at_columns(&mesh.points, &columns));
-        let walls = entropy::VertexWalls::new(surface, self.topology, layered);
+        let walls = entropy::VertexWalls::new(surface, self.topology, layered)
+            .with_cylinders(&self.normals.cylinder_normals);
         let stats = march::march(
             &mut mesh,
             &mut columns,

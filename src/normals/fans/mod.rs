@@ -15,6 +15,8 @@
 //! 0 is on `t1`'s side; quad j is `(w_j, v_j, v_j+1, w_j+1)`, which runs along the shared column
 //! edges opposite to `t1` and `t2`, so the front stays consistently oriented.
 
+mod ridge_roots;
+
 use glam::DVec3;
 
 use super::most_normal::most_normal;
@@ -24,6 +26,7 @@ use crate::layers::slab::Polygon;
 use crate::surface::features::{EdgeKind, Features};
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
+use ridge_roots::RidgeRoot;
 
 /// One column to extrude: from wall vertex `vertex` along `direction`, `scale` times the layer
 /// distance.
@@ -61,6 +64,9 @@ pub struct NormalStats {
     pub fan_columns: usize,
     pub fan_edges: usize,
     pub corner_patches: usize,
+    /// Convex ridges ending on concave ones, whose fans go on to their root
+    /// ([`ridge_roots`]: a wing's trailing edge on a plate).
+    pub ridge_roots: usize,
     /// Sectors where no single direction sees all their faces (an angle-weighted normal is used).
     pub no_common_normal: usize,
 }
@@ -74,6 +80,11 @@ pub struct WallNormals {
     pub fan_faces: Vec<FanFace>,
     /// How each column may move ([`super::constraint::constrain_columns`]); empty: all free.
     pub slides: Vec<super::constraint::Slide>,
+    /// At every ridge root ([`ridge_roots`]), the directions across the ridge its fan columns
+    /// turn towards the floor, as (wall vertex, direction), sorted by vertex: the normals of the
+    /// ridge's offset cylinder there, a wall of their own for the entropy merges
+    /// ([`crate::layers::entropy::VertexWalls`]).
+    pub cylinder_normals: Vec<(u32, DVec3)>,
     pub stats: NormalStats,
 }
 
@@ -134,8 +145,14 @@ pub fn wall_normals_of_layered(
     let is_cut = |e: u32| is_fan_edge(e) || (uses_layered(e).any(|l| l) && uses_layered(e).any(|l| !l));
     // Per (vertex, fan edge): the sector columns on the edge's t1 side (index 0) and t2 side.
     let mut fan_ends: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); surface.points.len()];
+    let mut roots = ridge_roots::find(surface, topology, features, &is_cut);
+    let mut next_root = roots.iter_mut().peekable();
     for v in 0..surface.points.len() as u32 {
         if topology.vertex_triangles(v).is_empty() {
+            continue;
+        }
+        if let Some(root) = next_root.next_if(|r| r.vertex == v) {
+            root.side_columns(surface, topology, &mut out, &mut fan_ends[v as usize]);
             continue;
         }
         let ring = vertex_ring(surface, topology, v);
@@ -144,8 +161,15 @@ pub fn wall_normals_of_layered(
     }
     let fan_edges: Vec<u32> = (0..topology.edge_count() as u32).filter(|&e| is_fan_edge(e)).collect();
     let segments = fan_segments(topology, &fan_edges, &fan_ends, &out.columns, fan_angle);
-    let fans = fan_columns(surface, topology, &fan_edges, &segments, &fan_ends, &mut out);
+    let fans = fan_columns(surface, topology, &fan_edges, &segments, &fan_ends, &roots, &mut out);
     strips(surface, topology, &fan_edges, &segments, &fans, &mut out);
+    for root in &roots {
+        let i = fan_edges.binary_search(&root.ridge).expect("a ridge root's ridge is a fan edge");
+        let side = usize::from(topology.edges[root.ridge as usize][1] == root.vertex);
+        root.close_onto_floor(surface, &fans.at[i][side], &mut out);
+    }
+    out.stats.ridge_roots = roots.len();
+    out.cylinder_normals.sort_by_key(|&(v, _)| v);
     corner_patches(surface, topology, &fan_edges, &fan_ends, &fans, fan_angle, &mut out);
     out.stats.columns = out.columns.len();
     out.stats.fan_edges = fan_edges.len();
@@ -288,6 +312,7 @@ fn fan_columns(
     fan_edges: &[u32],
     segments: &[u32],
     fan_ends: &[Vec<(u32, u32, u32)>],
+    roots: &[RidgeRoot],
     out: &mut WallNormals,
 ) -> FanColumns {
     let mut at: Vec<[Vec<u32>; 2]> = vec![[Vec::new(), Vec::new()]; fan_edges.len()];
@@ -296,6 +321,10 @@ fn fan_columns(
         for (side, &v) in topology.edges[e as usize].iter().enumerate() {
             let ends = &fan_ends[v as usize];
             let (a, b) = ends_at(fan_ends, v, e);
+            if let Ok(r) = roots.binary_search_by_key(&v, |r| r.vertex) {
+                at[i][side] = roots[r].fan(surface, topology, (a, b), m, out);
+                continue;
+            }
             // A ridge vertex shares its fan between its two ridge edges, if the other edge's
             // fan is already built between the same two sector columns.
             let shared = (ends.len() == 2)
