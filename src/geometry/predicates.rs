@@ -43,6 +43,62 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
     Sign::of(-robust::orient3d(c3(a), c3(b), c3(c), c3(d)))
 }
 
+/// Exact position of `e` relative to the sphere through `a, b, c, d`, a tetrahedron positive by
+/// [`orient3d`]: `Positive` strictly inside, `Zero` on the sphere, `Negative` outside. (The raw
+/// `robust::insphere` expects the opposite orientation; never call it directly.)
+pub fn insphere(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Sign {
+    Sign::of(-robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)))
+}
+
+/// [`insphere`] with the cospherical case decided by a symbolic perturbation, so that the answer
+/// is never `Zero` for five distinct points. Every point is lifted onto the paraboloid
+/// `|p|^2` plus an infinitesimal that is larger the later the point comes in lexicographic
+/// `(x, y, z)` order, the larger ones infinitely so; the sign of the perturbed determinant is
+/// that of its first non-zero term, taken from the latest point on:
+/// - `e` itself: lifted above the sphere's hyperplane, it is outside (`Negative`);
+/// - a corner: the hyperplane rises there, so `e` is inside exactly when it lies strictly on
+///   that corner's side of the opposite face, the sign of [`orient3d`] with `e` in the
+///   corner's place; when it is zero (`e` in that face's plane), the next point decides.
+///
+/// A perturbation depends on the point alone, so every test sees the same perturbed point set:
+/// Delaunay's insertion algorithms work on it as on points in general position. Coincident
+/// points are not perturbed apart (the answer is then `Negative`).
+pub fn insphere_perturbed(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Sign {
+    let exact = insphere(a, b, c, d, e);
+    if exact != Sign::Zero {
+        return exact;
+    }
+    let mut latest_first = [(a, 0), (b, 1), (c, 2), (d, 3), (e, 4)];
+    latest_first.sort_unstable_by(|p, q| lexicographic(q.0, p.0));
+    let corners = [a, b, c, d];
+    for (_, which) in latest_first {
+        if which == 4 {
+            return Sign::Negative;
+        }
+        let mut moved = corners;
+        moved[which] = e;
+        let side = orient3d(moved[0], moved[1], moved[2], moved[3]);
+        if side != Sign::Zero {
+            return side;
+        }
+    }
+    Sign::Negative
+}
+
+/// The order of points by x, then y, then z (the order of [`insphere_perturbed`]).
+pub fn lexicographic(p: DVec3, q: DVec3) -> std::cmp::Ordering {
+    let by = |s: f64, t: f64| s.partial_cmp(&t).unwrap_or(std::cmp::Ordering::Equal);
+    by(p.x, q.x).then(by(p.y, q.y)).then(by(p.z, q.z))
+}
+
+/// Whether `a`, `b` and `c` lie on one line (or coincide), exactly: the cross product of
+/// `b - a` and `c - a` vanishes when its three components, the orientations of the points
+/// projected on the three coordinate planes, all do.
+pub fn collinear(a: DVec3, b: DVec3, c: DVec3) -> bool {
+    let on = |i: usize, j: usize| orient2d([a[i], a[j]], [b[i], b[j]], [c[i], c[j]]) == Sign::Zero;
+    on(0, 1) && on(1, 2) && on(2, 0)
+}
+
 /// Relative error bound of the floating-point `orient3d` determinant over its permanent
 /// (Shewchuk's first stage, "errboundA"), with the half-ulp epsilon of f64.
 const ORIENT3D_ERROR_A: f64 = (7.0 + 56.0 * HALF_EPSILON) * HALF_EPSILON;
@@ -116,6 +172,50 @@ mod tests {
     fn orient2d_ccw_is_positive() {
         assert_eq!(orient2d([0.0, 0.0], [1.0, 0.0], [0.0, 1.0]), Sign::Positive);
         assert_eq!(orient2d([0.0, 0.0], [1.0, 1.0], [2.0, 2.0]), Sign::Zero);
+    }
+
+    #[test]
+    fn insphere_is_positive_inside_a_positive_tet() {
+        let (a, b, c, d) = (DVec3::ZERO, DVec3::X, DVec3::Y, DVec3::Z);
+        assert_eq!(orient3d(a, b, c, d), Sign::Positive);
+        assert_eq!(insphere(a, b, c, d, DVec3::splat(0.25)), Sign::Positive);
+        assert_eq!(insphere(a, b, c, d, DVec3::splat(2.0)), Sign::Negative);
+        assert_eq!(insphere(a, b, c, d, DVec3::ONE), Sign::Zero, "a cube's corners share a sphere");
+    }
+
+    /// On the eight corners of a cube every insphere is zero; the perturbed one is never zero,
+    /// and it agrees with a lifting in which a later point (lexicographic) rises more: the
+    /// corner (1, 1, 1), latest of all, is outside every sphere of the others.
+    #[test]
+    fn perturbed_insphere_decides_cospherical_points() {
+        let corner = |i: u32| DVec3::new((i & 1) as f64, ((i >> 1) & 1) as f64, ((i >> 2) & 1) as f64);
+        let latest = DVec3::ONE;
+        for t in 0..8u32.pow(4) {
+            let mut tet = [t % 8, t / 8 % 8, t / 64 % 8, t / 512].map(corner);
+            if orient3d(tet[0], tet[1], tet[2], tet[3]) != Sign::Positive || tet.contains(&latest) {
+                tet.swap(0, 1);
+                if orient3d(tet[0], tet[1], tet[2], tet[3]) != Sign::Positive || tet.contains(&latest) {
+                    continue;
+                }
+            }
+            let [a, b, c, d] = tet;
+            assert_eq!(insphere(a, b, c, d, latest), Sign::Zero);
+            assert_eq!(insphere_perturbed(a, b, c, d, latest), Sign::Negative);
+            for e in (0..8).map(corner).filter(|e| !tet.contains(e)) {
+                assert_ne!(insphere_perturbed(a, b, c, d, e), Sign::Zero);
+            }
+        }
+    }
+
+    #[test]
+    fn collinear_is_exact() {
+        // a + 3 (b - a), exactly.
+        let (a, b) = (DVec3::new(0.5, 0.25, 1.0), DVec3::new(1.5, 2.25, -1.0));
+        assert!(collinear(a, b, DVec3::new(3.5, 6.25, -5.0)));
+        assert!(collinear(a, a, b));
+        let (o, c) = (DVec3::ZERO, DVec3::new(2.0, 2.0, 2.0 + 2f64.powi(-50)));
+        assert!(collinear(o, DVec3::ONE, DVec3::splat(2.0)));
+        assert!(!collinear(o, DVec3::ONE, c), "two ulps off the line");
     }
 
     proptest! {
