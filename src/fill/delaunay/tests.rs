@@ -377,3 +377,25 @@ fn tet_mesh_gets_every_tetrahedron() {
     assert_eq!(from_mesh, ours);
     assert_eq!(mesh.points.len(), 300);
 }
+
+/// On points in general position the Delaunay tetrahedralisation is unique: TetGen's is ours.
+#[cfg(feature = "tetgen")]
+#[test]
+fn tetgen_finds_the_same_tetrahedra() {
+    let points = cloud(Cloud::Uniform, 2000, 5);
+    let ours = Delaunay::new(&points).unwrap();
+    let theirs = crate::fill::tetgen::delaunay_of_points(&points).expect("TetGen runs");
+    let corner = |v: u32| points[v as usize].to_array().map(f64::to_bits);
+    let mut by_corners: Vec<[[u64; 3]; 4]> = theirs
+        .iter()
+        .map(|t| {
+            let [a, b, c, e] = t.map(|v| points[v as usize]);
+            assert_eq!(orient3d(a, b, c, e), Sign::Positive, "TetGen's orientation is ours");
+            let mut corners = t.map(corner);
+            corners.sort_unstable();
+            corners
+        })
+        .collect();
+    by_corners.sort_unstable();
+    assert_eq!(tets_by_corners(&ours), by_corners);
+}
