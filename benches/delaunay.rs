@@ -25,16 +25,20 @@ fn main() {
         compare("cube-10k", 1, &cube(10_000));
         return;
     }
-    let cases: [(&str, usize, fn() -> Vec<DVec3>); 4] = [
-        ("cube-100k", 5, || cube(100_000)),
-        ("cube-1m", 3, || cube(1_000_000)),
-        ("sphere-100k", 5, || shell(100_000, 0.0)),
-        ("shell-100k", 5, || shell(100_000, 0.01)),
-    ];
-    for (name, runs, points) in cases {
+    for (name, runs) in [("cube-100k", 5), ("cube-1m", 3), ("sphere-100k", 5), ("shell-100k", 5)] {
         if picked(name) {
-            compare(name, runs, &points());
+            compare(name, runs, &points_of(name));
         }
+    }
+}
+
+/// The points of case `name`.
+fn points_of(name: &str) -> Vec<DVec3> {
+    match name {
+        "cube-100k" => cube(100_000),
+        "cube-1m" => cube(1_000_000),
+        "sphere-100k" => shell(100_000, 0.0),
+        _ => shell(100_000, 0.01),
     }
 }
 
