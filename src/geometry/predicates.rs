@@ -64,10 +64,15 @@ pub fn insphere(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Sign {
 /// Delaunay's insertion algorithms work on it as on points in general position. Coincident
 /// points are not perturbed apart (the answer is then `Negative`).
 pub fn insphere_perturbed(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Sign {
-    let exact = insphere(a, b, c, d, e);
-    if exact != Sign::Zero {
-        return exact;
+    match insphere(a, b, c, d, e) {
+        Sign::Zero => insphere_tie(a, b, c, d, e),
+        exact => exact,
     }
+}
+
+/// [`insphere_perturbed`] where [`insphere`] is zero (`e` on the sphere): the perturbation's
+/// verdict alone.
+pub fn insphere_tie(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Sign {
     let mut latest_first = [(a, 0), (b, 1), (c, 2), (d, 3), (e, 4)];
     latest_first.sort_unstable_by(|p, q| lexicographic(q.0, p.0));
     let corners = [a, b, c, d];

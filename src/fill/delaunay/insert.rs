@@ -1,15 +1,15 @@
 //! Bowyer–Watson insertion: locate by a visibility walk, grow the cavity, join its boundary
 //! to the new point.
 
-use super::{Delaunay, FACES, FREE, INFINITE};
-use crate::geometry::predicates::{insphere_perturbed, orient3d, Sign};
+use super::{Cell, Delaunay, FACES, FREE, INFINITE};
+use crate::geometry::predicates::{insphere, insphere_tie, orient3d, Sign};
 use crate::geometry::DVec3;
 
 /// Reusable buffers of one insertion.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Scratch {
-    /// Per tetrahedron slot, what the insertion numbered `generation` found:
-    /// `2 * generation` in the cavity, `2 * generation + 1` tested and outside.
+    /// Per tetrahedron slot, the [`Verdict`] of the insertion numbered `generation`:
+    /// `4 * generation + verdict`; below, not tested by it.
     mark: Vec<u32>,
     generation: u32,
     stack: Vec<u32>,
@@ -20,10 +20,10 @@ pub(super) struct Scratch {
 }
 
 impl Scratch {
-    /// Start an insertion among `slots` tetrahedron slots: the marks (in cavity, outside).
-    fn begin(&mut self, slots: usize) -> (u32, u32) {
+    /// Start an insertion among `slots` tetrahedron slots: the mark of the first verdict.
+    fn begin(&mut self, slots: usize) -> u32 {
         self.mark.resize(slots, 0);
-        if self.generation >= u32::MAX / 2 - 1 {
+        if self.generation >= u32::MAX / 4 - 1 {
             self.mark.fill(0);
             self.generation = 0;
         }
@@ -32,7 +32,44 @@ impl Scratch {
         self.cavity.clear();
         self.boundary.clear();
         self.created.clear();
-        (2 * self.generation, 2 * self.generation + 1)
+        4 * self.generation
+    }
+}
+
+/// Whether a tetrahedron is in the cavity of the point being inserted, and whether the exact
+/// predicate said so (a strict verdict) or the perturbation (a tie broken).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u32)]
+enum Verdict {
+    Inside = 0,
+    InsideByTie = 1,
+    Outside = 2,
+    OutsideByTie = 3,
+}
+
+impl Verdict {
+    fn of_mark(mark: u32, base: u32) -> Option<Verdict> {
+        match mark.checked_sub(base)? {
+            0 => Some(Verdict::Inside),
+            1 => Some(Verdict::InsideByTie),
+            2 => Some(Verdict::Outside),
+            3 => Some(Verdict::OutsideByTie),
+            _ => None,
+        }
+    }
+
+    fn inside(self) -> bool {
+        matches!(self, Verdict::Inside | Verdict::InsideByTie)
+    }
+
+    /// The verdict of a predicate's sign (`Positive`: inside), strict or not.
+    fn of_sign(sign: Sign, strict: bool) -> Verdict {
+        match (sign == Sign::Positive, strict) {
+            (true, true) => Verdict::Inside,
+            (true, false) => Verdict::InsideByTie,
+            (false, true) => Verdict::Outside,
+            (false, false) => Verdict::OutsideByTie,
+        }
     }
 }
 
@@ -77,27 +114,27 @@ impl Delaunay {
         let mut t = self.hint;
         let mut came_from = FREE;
         for _ in 0..self.cells.len() {
-            let cell = self.cells[t as usize];
+            let cell = self.cells[t as usize].vertices;
             if let Some(k) = infinite_at(cell) {
                 let [a, b, c] = FACES[k].map(|i| self.points[cell[i] as usize]);
                 if orient3d(a, b, c, p) == Sign::Positive {
                     return t;
                 }
                 came_from = t;
-                t = self.neighbours[t as usize][k];
+                t = self.cells[t as usize].neighbours[k];
                 continue;
             }
             let corners = cell.map(|v| self.points[v as usize]);
             let first = (self.rng.next_u64() >> 62) as usize;
             let exit = (0..4).map(|j| (first + j) & 3).find(|&i| {
-                let n = self.neighbours[t as usize][i];
+                let n = self.cells[t as usize].neighbours[i];
                 let [a, b, c] = FACES[i].map(|l| corners[l]);
                 n != came_from && orient3d(a, b, c, p) == Sign::Negative
             });
             match exit {
                 Some(i) => {
                     came_from = t;
-                    t = self.neighbours[t as usize][i];
+                    t = self.cells[t as usize].neighbours[i];
                 }
                 None => return t,
             }
@@ -108,7 +145,7 @@ impl Delaunay {
     /// [`Delaunay::locate`] over every tetrahedron.
     fn locate_by_search(&self, p: DVec3) -> u32 {
         let contains = |t: &usize| {
-            let cell = self.cells[*t];
+            let cell = self.cells[*t].vertices;
             if cell[0] == FREE {
                 return false;
             }
@@ -126,24 +163,29 @@ impl Delaunay {
 
     /// The finite vertex of tetrahedron `t` at `p`, if any.
     pub(super) fn vertex_at(&self, t: u32, p: DVec3) -> Option<u32> {
-        let cell = self.cells[t as usize];
+        let cell = self.cells[t as usize].vertices;
         cell.into_iter().find(|&v| v != INFINITE && self.points[v as usize] == p)
     }
 
     /// Whether `p` is in the cavity of tetrahedron `t` (the module's predicate rules).
-    fn in_conflict(&self, t: u32, p: DVec3) -> bool {
-        let cell = self.cells[t as usize];
+    fn verdict(&self, t: u32, p: DVec3) -> Verdict {
+        let cell = self.cells[t as usize].vertices;
         match infinite_at(cell) {
             None => {
                 let [a, b, c, d] = cell.map(|v| self.points[v as usize]);
-                insphere_perturbed(a, b, c, d, p) == Sign::Positive
+                match insphere(a, b, c, d, p) {
+                    Sign::Zero => Verdict::of_sign(insphere_tie(a, b, c, d, p), false),
+                    sign => Verdict::of_sign(sign, true),
+                }
             }
             Some(k) => {
                 let [a, b, c] = FACES[k].map(|i| self.points[cell[i] as usize]);
                 match orient3d(a, b, c, p) {
-                    Sign::Positive => true,
-                    Sign::Negative => false,
-                    Sign::Zero => self.in_conflict(self.neighbours[t as usize][k], p),
+                    Sign::Zero => match self.verdict(self.cells[t as usize].neighbours[k], p) {
+                        Verdict::Inside | Verdict::InsideByTie => Verdict::InsideByTie,
+                        Verdict::Outside | Verdict::OutsideByTie => Verdict::OutsideByTie,
+                    },
+                    sign => Verdict::of_sign(sign, true),
                 }
             }
         }
@@ -152,7 +194,7 @@ impl Delaunay {
     /// Whether the tetrahedron that joins `p` to face `i` of tetrahedron `t` is positive
     /// (or infinite: the hull around it stays convex when the finite ones are positive).
     fn joins_positive(&self, t: u32, i: usize, p: DVec3) -> bool {
-        let cell = self.cells[t as usize];
+        let cell = self.cells[t as usize].vertices;
         if infinite_at(cell).is_some_and(|k| k != i) {
             return true;
         }
@@ -170,38 +212,52 @@ impl Delaunay {
     }
 
     /// The cavity of `v` from `start`: the tetrahedra in conflict reachable through others,
-    /// and those across boundary faces that do not join `v` positively.
+    /// and those across boundary faces that do not join `v` positively. A face between strict
+    /// verdicts needs no test: the two circumspheres meet in the face's plane, so a point
+    /// strictly inside one and strictly outside the other is strictly on the first's side (as
+    /// long as the tetrahedralisation is Delaunay: no repair so far).
     fn grow_cavity(&mut self, s: &mut Scratch, v: u32, start: u32) {
         let p = self.points[v as usize];
-        let (inside, outside) = s.begin(self.cells.len());
-        s.mark[start as usize] = inside;
+        let base = s.begin(self.cells.len());
+        // A point in a tetrahedron's closure, not at a vertex, is strictly inside its sphere.
+        s.mark[start as usize] = base + Verdict::Inside as u32;
         s.cavity.push(start);
         s.stack.push(start);
         while let Some(t) = s.stack.pop() {
+            let strict = s.mark[t as usize] == base + Verdict::Inside as u32 && self.repairs == 0;
             for i in 0..4 {
-                let n = self.neighbours[t as usize][i];
-                let mark = s.mark[n as usize];
-                if mark == inside {
+                let n = self.cells[t as usize].neighbours[i];
+                let verdict = match Verdict::of_mark(s.mark[n as usize], base) {
+                    Some(known) => known,
+                    None => {
+                        let new = self.verdict(n, p);
+                        s.mark[n as usize] = base + new as u32;
+                        if new.inside() {
+                            s.cavity.push(n);
+                            s.stack.push(n);
+                        }
+                        new
+                    }
+                };
+                if verdict.inside() || (strict && verdict == Verdict::Outside) || self.joins_positive(t, i, p)
+                {
                     continue;
                 }
-                let joins = mark == outside || !self.in_conflict(n, p);
-                if joins && self.joins_positive(t, i, p) {
-                    s.mark[n as usize] = outside;
-                    continue;
-                }
-                self.repairs += usize::from(joins);
-                s.mark[n as usize] = inside;
+                self.repairs += 1;
+                s.mark[n as usize] = base + Verdict::InsideByTie as u32;
                 s.cavity.push(n);
                 s.stack.push(n);
             }
         }
+        let inside = |mark: u32| Verdict::of_mark(mark, base).is_some_and(Verdict::inside);
         for &t in &s.cavity {
-            let cell = self.cells[t as usize];
-            for (i, &n) in self.neighbours[t as usize].iter().enumerate() {
-                if s.mark[n as usize] == inside {
+            let cell = self.cells[t as usize].vertices;
+            for (i, &n) in self.cells[t as usize].neighbours.iter().enumerate() {
+                if inside(s.mark[n as usize]) {
                     continue;
                 }
-                let back = self.neighbours[n as usize].iter().position(|&m| m == t).expect("linked faces");
+                let back =
+                    self.cells[n as usize].neighbours.iter().position(|&m| m == t).expect("linked faces");
                 let mut joined = cell;
                 joined[i] = v;
                 s.boundary.push(BoundaryFace { cell: joined, apex: i, outside: n, back });
@@ -216,18 +272,17 @@ impl Delaunay {
             let slot = match s.cavity.get(k) {
                 Some(&slot) => slot,
                 None => self.free.pop().unwrap_or_else(|| {
-                    self.cells.push([FREE; 4]);
-                    self.neighbours.push([FREE; 4]);
+                    self.cells.push(Cell::FREE);
                     self.cells.len() as u32 - 1
                 }),
             };
-            self.cells[slot as usize] = face.cell;
-            self.neighbours[slot as usize][face.apex] = face.outside;
-            self.neighbours[face.outside as usize][face.back] = slot;
+            self.cells[slot as usize].vertices = face.cell;
+            self.cells[slot as usize].neighbours[face.apex] = face.outside;
+            self.cells[face.outside as usize].neighbours[face.back] = slot;
             s.created.push(slot);
         }
         for &slot in s.cavity.iter().skip(s.boundary.len()) {
-            self.cells[slot as usize] = [FREE; 4];
+            self.cells[slot as usize].vertices = [FREE; 4];
             self.free.push(slot);
         }
         s.edges.reset(s.boundary.len());
@@ -238,14 +293,14 @@ impl Delaunay {
                 // The tetrahedron across reads the shared face (v, b, a).
                 match s.edges.get(b, a) {
                     Some((other, l)) => {
-                        self.neighbours[slot as usize][j] = other;
-                        self.neighbours[other as usize][l] = slot;
+                        self.cells[slot as usize].neighbours[j] = other;
+                        self.cells[other as usize].neighbours[l] = slot;
                     }
                     None => s.edges.put(a, b, slot, j),
                 }
             }
         }
-        let finite = s.created.iter().rev().find(|&&t| !self.cells[t as usize].contains(&INFINITE));
+        let finite = s.created.iter().rev().find(|&&t| !self.cells[t as usize].vertices.contains(&INFINITE));
         self.hint = *finite.expect("a new vertex has a finite tetrahedron");
     }
 }

@@ -77,11 +77,8 @@ const SEED: u64 = 0x5EED_DE1A_07A7_0001;
 pub struct Delaunay {
     /// Every point given, inserted or not: vertex `v` is `points[v]`.
     points: Vec<DVec3>,
-    /// The vertices of every tetrahedron slot: positive when finite, one of them [`INFINITE`]
-    /// on the hull, all [`FREE`] in a free slot.
-    cells: Vec<[u32; 4]>,
-    /// The tetrahedron across the face opposite each vertex of every tetrahedron.
-    neighbours: Vec<[u32; 4]>,
+    /// Every tetrahedron slot.
+    cells: Vec<Cell>,
     /// Free slots of `cells`.
     free: Vec<u32>,
     /// A live finite tetrahedron near the last point inserted, where the next walk starts.
@@ -90,6 +87,18 @@ pub struct Delaunay {
     duplicates: Vec<Duplicate>,
     repairs: usize,
     scratch: insert::Scratch,
+}
+
+/// A tetrahedron slot: the vertices (positive when finite, one of them [`INFINITE`] on the
+/// hull, all [`FREE`] in a free slot) and the tetrahedra across the faces opposite them.
+#[derive(Clone, Copy, Debug)]
+struct Cell {
+    vertices: [u32; 4],
+    neighbours: [u32; 4],
+}
+
+impl Cell {
+    const FREE: Cell = Cell { vertices: [FREE; 4], neighbours: [FREE; 4] };
 }
 
 /// A point not inserted because it coincides with a vertex.
@@ -132,10 +141,13 @@ impl Delaunay {
         if let Some(i) = points.iter().position(|p| !p.is_finite()) {
             return Err(DelaunayError::NotFinite(i));
         }
+        // Inserted as vertices numbered in insertion order, so that the points of neighbouring
+        // tetrahedra are near in memory too; renumbered as the input at the end.
         let order = sort::insertion_order(points);
-        let first = first_tetrahedron(points, &order).ok_or(DelaunayError::Flat(points.len()))?;
-        let mut delaunay = Delaunay::around(points.to_vec(), first);
-        for &v in order.iter().filter(|v| !first.contains(v)) {
+        let in_order: Vec<DVec3> = order.iter().map(|&v| points[v as usize]).collect();
+        let first = first_tetrahedron(&in_order).ok_or(DelaunayError::Flat(points.len()))?;
+        let mut delaunay = Delaunay::around(in_order, first);
+        for v in (0..points.len() as u32).filter(|v| !first.contains(v)) {
             let p = delaunay.points[v as usize];
             let start = delaunay.locate(p);
             match delaunay.vertex_at(start, p) {
@@ -143,7 +155,20 @@ impl Delaunay {
                 None => delaunay.insert_vertex(v, start),
             }
         }
+        delaunay.renumber(&order, points);
         Ok(delaunay)
+    }
+
+    /// Vertex `v` becomes `input[v]`, and the points `points` (in input order).
+    fn renumber(&mut self, input: &[u32], points: &[DVec3]) {
+        let number = |v: u32| if v < FREE { input[v as usize] } else { v };
+        for cell in &mut self.cells {
+            cell.vertices = cell.vertices.map(number);
+        }
+        for duplicate in &mut self.duplicates {
+            *duplicate = Duplicate { point: number(duplicate.point), of: number(duplicate.of) };
+        }
+        self.points = points.to_vec();
     }
 
     /// Insert `p` and return its vertex index (the next point index).
@@ -166,17 +191,18 @@ impl Delaunay {
 
     /// The tetrahedralisation of the tetrahedron `first` (positive) and its four hull faces.
     fn around(points: Vec<DVec3>, first: [u32; 4]) -> Delaunay {
-        let mut cells = vec![first];
+        let mut vertices = vec![first];
         for face in FACES {
             let [a, b, c] = face.map(|i| first[i]);
             // Reversed: facing out of the hull.
-            cells.push([a, c, b, INFINITE]);
+            vertices.push([a, c, b, INFINITE]);
         }
-        let neighbours = link_faces(&cells);
+        let neighbours = link_faces(&vertices);
+        let cells =
+            vertices.into_iter().zip(neighbours).map(|(vertices, neighbours)| Cell { vertices, neighbours });
         Delaunay {
             points,
-            cells,
-            neighbours,
+            cells: cells.collect(),
             free: Vec::new(),
             hint: 0,
             rng: SplitMix64::new(SEED),
@@ -193,12 +219,13 @@ impl Delaunay {
 
     /// The finite tetrahedra, positive by [`orient3d`].
     pub fn tets(&self) -> impl Iterator<Item = [u32; 4]> + '_ {
-        self.cells.iter().filter(|c| c[0] != FREE && !c.contains(&INFINITE)).copied()
+        self.cells.iter().map(|c| c.vertices).filter(|c| c[0] != FREE && !c.contains(&INFINITE))
     }
 
     /// The convex hull's triangles, their right-hand normals pointing out of the hull.
     pub fn hull_triangles(&self) -> impl Iterator<Item = [u32; 3]> + '_ {
-        self.cells.iter().filter_map(|&c| {
+        self.cells.iter().filter_map(|cell| {
+            let c = cell.vertices;
             let k = c.iter().position(|&v| v == INFINITE)?;
             Some(FACES[k].map(|i| c[i]))
         })
@@ -222,13 +249,13 @@ impl Delaunay {
 
     /// The vertices of tetrahedron `t` (one may be [`INFINITE`]); `None` for a free slot.
     pub fn cell(&self, t: u32) -> Option<[u32; 4]> {
-        let cell = self.cells[t as usize];
+        let cell = self.cells[t as usize].vertices;
         (cell[0] != FREE).then_some(cell)
     }
 
     /// The tetrahedra across the faces opposite each vertex of tetrahedron `t`.
     pub fn neighbours(&self, t: u32) -> [u32; 4] {
-        self.neighbours[t as usize]
+        self.cells[t as usize].neighbours
     }
 
     /// The finite tetrahedra as a [`TetMesh`] for the improvement operators, whose points
@@ -238,19 +265,19 @@ impl Delaunay {
     }
 }
 
-/// The first four points in `order` that span a tetrahedron, ordered positive; `None` when
-/// all lie in one plane.
-fn first_tetrahedron(points: &[DVec3], order: &[u32]) -> Option<[u32; 4]> {
-    let at = |v: &u32| points[*v as usize];
-    let a = *order.first()?;
-    let b = *order.iter().find(|v| at(v) != points[a as usize])?;
-    let (pa, pb) = (points[a as usize], points[b as usize]);
-    let c = *order.iter().find(|v| !collinear(pa, pb, at(v)))?;
-    let pc = points[c as usize];
-    let d = *order.iter().find(|v| orient3d(pa, pb, pc, at(v)) != Sign::Zero)?;
+/// The first four of `points` that span a tetrahedron, ordered positive; `None` when all lie
+/// in one plane.
+fn first_tetrahedron(points: &[DVec3]) -> Option<[u32; 4]> {
+    let pa = *points.first()?;
+    let b = points.iter().position(|&p| p != pa)?;
+    let pb = points[b];
+    let c = points.iter().position(|&p| !collinear(pa, pb, p))?;
+    let pc = points[c];
+    let d = points.iter().position(|&p| orient3d(pa, pb, pc, p) != Sign::Zero)?;
+    let [b, c, d] = [b, c, d].map(|i| i as u32);
     match orient3d(pa, pb, pc, points[d as usize]) {
-        Sign::Positive => Some([a, b, c, d]),
-        _ => Some([b, a, c, d]),
+        Sign::Positive => Some([0, b, c, d]),
+        _ => Some([b, 0, c, d]),
     }
 }
 

@@ -256,10 +256,9 @@ proptest! {
     fn one_by_one_gives_the_bulk_result(kind in cloud_strategy(), n in 8usize..=60, seed in any::<u64>()) {
         let points = cloud(kind, n, seed);
         let bulk = Delaunay::new(&points).map_err(|e| TestCaseError::fail(e.to_string()))?;
-        let in_input_order: Vec<u32> = (0..n as u32).collect();
-        let start = first_tetrahedron(&points, &in_input_order).expect("not flat");
+        let start = first_tetrahedron(&points).expect("not flat");
         let mut one = Delaunay::new(&start.map(|v| points[v as usize])).expect("a tetrahedron");
-        for v in in_input_order.into_iter().filter(|v| !start.contains(v)) {
+        for v in (0..n as u32).filter(|v| !start.contains(v)) {
             match one.insert(points[v as usize]) {
                 Ok(_) => {}
                 Err(InsertError::Duplicate(of)) => prop_assert_eq!(one.points()[of as usize], points[v as usize]),
@@ -328,8 +327,7 @@ fn degenerate_starts_find_a_tetrahedron() {
     let mut points: Vec<DVec3> = (0..100).map(|i| DVec3::new(i as f64, 0.0, 0.0)).collect();
     points.extend((0..100).map(|i| DVec3::new((i % 10) as f64, (i / 10) as f64, 0.0)));
     points.push(DVec3::new(0.5, 0.5, 1.0));
-    let in_input_order: Vec<u32> = (0..points.len() as u32).collect();
-    let first = first_tetrahedron(&points, &in_input_order).expect("one point off the plane");
+    let first = first_tetrahedron(&points).expect("one point off the plane");
     assert_eq!(first, [0, 1, 110, 200], "the first two, the first off their line, the first off the plane");
     let d = Delaunay::new(&points).expect("one point off the plane");
     assert_eq!(check(&d, true), Ok(()));
