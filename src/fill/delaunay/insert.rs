@@ -8,10 +8,12 @@ use crate::geometry::DVec3;
 /// Reusable buffers of one insertion.
 #[derive(Clone, Debug, Default)]
 pub(super) struct Scratch {
-    /// Per tetrahedron slot, the [`Verdict`] of the insertion numbered `generation`:
-    /// `4 * generation + verdict`; below, not tested by it.
-    mark: Vec<u32>,
-    generation: u32,
+    /// Per tetrahedron slot, the verdict of the insertion under way, if it tested it (one
+    /// byte a slot, cleared after each insertion: the slots it tests are few, and a small
+    /// array stays in the cache).
+    verdicts: Vec<Option<Verdict>>,
+    /// The slots with a verdict.
+    tested: Vec<u32>,
     stack: Vec<u32>,
     cavity: Vec<u32>,
     boundary: Vec<BoundaryFace>,
@@ -20,44 +22,50 @@ pub(super) struct Scratch {
 }
 
 impl Scratch {
-    /// Start an insertion among `slots` tetrahedron slots: the mark of the first verdict.
-    fn begin(&mut self, slots: usize) -> u32 {
-        self.mark.resize(slots, 0);
-        if self.generation >= u32::MAX / 4 - 1 {
-            self.mark.fill(0);
-            self.generation = 0;
-        }
-        self.generation += 1;
+    /// Start an insertion among `slots` tetrahedron slots.
+    fn begin(&mut self, slots: usize) {
+        self.verdicts.resize(slots, None);
         self.stack.clear();
         self.cavity.clear();
         self.boundary.clear();
         self.created.clear();
-        4 * self.generation
+    }
+
+    /// Record the verdict on `t`; one inside joins the cavity, to grow from.
+    fn judge(&mut self, t: u32, verdict: Verdict) {
+        if self.verdicts[t as usize].replace(verdict).is_none() {
+            self.tested.push(t);
+        }
+        if verdict.inside() {
+            self.cavity.push(t);
+            self.stack.push(t);
+        }
+    }
+
+    fn inside(&self, t: u32) -> bool {
+        self.verdicts[t as usize].is_some_and(Verdict::inside)
+    }
+
+    /// Forget the verdicts.
+    fn end(&mut self) {
+        for &t in &self.tested {
+            self.verdicts[t as usize] = None;
+        }
+        self.tested.clear();
     }
 }
 
 /// Whether a tetrahedron is in the cavity of the point being inserted, and whether the exact
 /// predicate said so (a strict verdict) or the perturbation (a tie broken).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
-#[repr(u32)]
 enum Verdict {
-    Inside = 0,
-    InsideByTie = 1,
-    Outside = 2,
-    OutsideByTie = 3,
+    Inside,
+    InsideByTie,
+    Outside,
+    OutsideByTie,
 }
 
 impl Verdict {
-    fn of_mark(mark: u32, base: u32) -> Option<Verdict> {
-        match mark.checked_sub(base)? {
-            0 => Some(Verdict::Inside),
-            1 => Some(Verdict::InsideByTie),
-            2 => Some(Verdict::Outside),
-            3 => Some(Verdict::OutsideByTie),
-            _ => None,
-        }
-    }
-
     fn inside(self) -> bool {
         matches!(self, Verdict::Inside | Verdict::InsideByTie)
     }
@@ -208,6 +216,7 @@ impl Delaunay {
         let mut scratch = std::mem::take(&mut self.scratch);
         self.grow_cavity(&mut scratch, v, start);
         self.fill_cavity(&mut scratch);
+        scratch.end();
         self.scratch = scratch;
     }
 
@@ -218,42 +227,30 @@ impl Delaunay {
     /// long as the tetrahedralisation is Delaunay: no repair so far).
     fn grow_cavity(&mut self, s: &mut Scratch, v: u32, start: u32) {
         let p = self.points[v as usize];
-        let base = s.begin(self.cells.len());
+        s.begin(self.cells.len());
         // A point in a tetrahedron's closure, not at a vertex, is strictly inside its sphere.
-        s.mark[start as usize] = base + Verdict::Inside as u32;
-        s.cavity.push(start);
-        s.stack.push(start);
+        s.judge(start, Verdict::Inside);
         while let Some(t) = s.stack.pop() {
-            let strict = s.mark[t as usize] == base + Verdict::Inside as u32 && self.repairs == 0;
+            let strict = s.verdicts[t as usize] == Some(Verdict::Inside) && self.repairs == 0;
             for i in 0..4 {
                 let n = self.cells[t as usize].neighbours[i];
-                let verdict = match Verdict::of_mark(s.mark[n as usize], base) {
-                    Some(known) => known,
-                    None => {
-                        let new = self.verdict(n, p);
-                        s.mark[n as usize] = base + new as u32;
-                        if new.inside() {
-                            s.cavity.push(n);
-                            s.stack.push(n);
-                        }
-                        new
-                    }
-                };
+                let verdict = s.verdicts[n as usize].unwrap_or_else(|| {
+                    let new = self.verdict(n, p);
+                    s.judge(n, new);
+                    new
+                });
                 if verdict.inside() || (strict && verdict == Verdict::Outside) || self.joins_positive(t, i, p)
                 {
                     continue;
                 }
                 self.repairs += 1;
-                s.mark[n as usize] = base + Verdict::InsideByTie as u32;
-                s.cavity.push(n);
-                s.stack.push(n);
+                s.judge(n, Verdict::InsideByTie);
             }
         }
-        let inside = |mark: u32| Verdict::of_mark(mark, base).is_some_and(Verdict::inside);
         for &t in &s.cavity {
             let cell = self.cells[t as usize].vertices;
             for (i, &n) in self.cells[t as usize].neighbours.iter().enumerate() {
-                if inside(s.mark[n as usize]) {
+                if s.inside(n) {
                     continue;
                 }
                 let back =
