@@ -46,8 +46,48 @@ pub fn orient3d(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> Sign {
 /// Exact position of `e` relative to the sphere through `a, b, c, d`, a tetrahedron positive by
 /// [`orient3d`]: `Positive` strictly inside, `Zero` on the sphere, `Negative` outside. (The raw
 /// `robust::insphere` expects the opposite orientation; never call it directly.)
+///
+/// A semi-static filter first: the floating-point determinant (Shewchuk's expression, over the
+/// coordinates relative to `e`) decides where it exceeds a bound on its error computed from
+/// the largest relative coordinate on each axis, `X`, `Y`, `Z`: Shewchuk's bound is a multiple
+/// of the determinant's permanent, which is at most `24 X Y Z (X^2 + Y^2 + Z^2)` (four lifted
+/// terms, each at most `X^2 + Y^2 + Z^2` times three products of at most `2 X Y Z`). It is
+/// cheaper than the permanent, and as exact: the adaptive predicate decides the rest.
 pub fn insphere(a: DVec3, b: DVec3, c: DVec3, d: DVec3, e: DVec3) -> Sign {
+    let (ae, be, ce, de) = (a - e, b - e, c - e, d - e);
+    let det = insphere_determinant(ae, be, ce, de);
+    let m = ae.abs().max(be.abs()).max(ce.abs()).max(de.abs());
+    // Padded for the rounding of the permanent and of the bound itself.
+    let bound = INSPHERE_ERROR_A * 24.000_01 * (m.x * m.y * m.z) * m.length_squared();
+    // Below: the bound may have lost its accuracy to underflow.
+    const SMALLEST_BOUND: f64 = 1e-250;
+    if bound > SMALLEST_BOUND && det.abs() > bound {
+        return if det > 0.0 { Sign::Negative } else { Sign::Positive };
+    }
     Sign::of(-robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)))
+}
+
+/// Relative error bound of the floating-point `insphere` determinant over its permanent
+/// (Shewchuk's "isperrboundA").
+const INSPHERE_ERROR_A: f64 = (16.0 + 224.0 * HALF_EPSILON) * HALF_EPSILON;
+
+/// The determinant `robust::insphere` computes first (its sign for our orientation is the
+/// opposite), of the corners relative to the tested point, in the same order of operations
+/// (its error bound is for that order).
+#[inline]
+fn insphere_determinant(ae: DVec3, be: DVec3, ce: DVec3, de: DVec3) -> f64 {
+    let ab = ae.x * be.y - be.x * ae.y;
+    let bc = be.x * ce.y - ce.x * be.y;
+    let cd = ce.x * de.y - de.x * ce.y;
+    let da = de.x * ae.y - ae.x * de.y;
+    let ac = ae.x * ce.y - ce.x * ae.y;
+    let bd = be.x * de.y - de.x * be.y;
+    let abc = ae.z * bc - be.z * ac + ce.z * ab;
+    let bcd = be.z * cd - ce.z * bd + de.z * bc;
+    let cda = ce.z * da + de.z * ac + ae.z * cd;
+    let dab = de.z * ab + ae.z * bd + be.z * da;
+    let lift = |p: DVec3| p.x * p.x + p.y * p.y + p.z * p.z;
+    (lift(de) * abc - lift(ce) * dab) + (lift(be) * cda - lift(ae) * bcd)
 }
 
 /// [`insphere`] with the cospherical case decided by a symbolic perturbation, so that the answer
@@ -238,6 +278,32 @@ mod tests {
                 prop_assert_eq!(s, if v > 0.0 { Sign::Positive } else { Sign::Negative });
             }
             prop_assert_eq!(orient3d(b, a, c, d), s.flip());
+        }
+
+        /// The filtered insphere gives the adaptive predicate's sign, also for points on or
+        /// within a hair of the sphere, and in tiny or far boxes.
+        #[test]
+        fn insphere_filter_agrees_with_exact(
+            p in proptest::array::uniform12(-1.0f64..1.0),
+            q in proptest::array::uniform3(-1.0f64..1.0),
+            off in prop_oneof![Just(0.0), 1e-18f64..1e-12, 1e-6f64..1.0],
+            offset in prop_oneof![Just(0.0), -1e6f64..1e6],
+            scale in prop_oneof![Just(1.0), 1e-9f64..1e-3, 1e3f64..1e9],
+        ) {
+            // Four corners and a fifth point on (or off by `off`) the unit sphere around 0.
+            let on_sphere = |x: f64, y: f64, z: f64| {
+                let v = DVec3::new(x, y, z);
+                if v.length() > 1e-3 { v.normalize() } else { DVec3::X }
+            };
+            let corner = |i: usize| on_sphere(p[i], p[i + 1], p[i + 2]) * scale + DVec3::splat(offset);
+            let (mut a, mut b, c, d) = (corner(0), corner(3), corner(6), corner(9));
+            if orient3d(a, b, c, d) == Sign::Negative {
+                std::mem::swap(&mut a, &mut b);
+            }
+            let e = on_sphere(q[0], q[1], q[2]) * (1.0 + off) * scale + DVec3::splat(offset);
+            let exact = Sign::of(-robust::insphere(c3(a), c3(b), c3(c), c3(d), c3(e)));
+            prop_assert_eq!(insphere(a, b, c, d, e), exact);
+            prop_assert_eq!(insphere(a, b, c, d, a), Sign::Zero);
         }
 
         /// The boxed filter gives the exact sign, also for nearly flat tetrahedra (d pulled
