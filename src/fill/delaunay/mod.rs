@@ -34,7 +34,7 @@
 //!   order that are not coplanar (exact tests); all points coplanar is an error.
 //!
 //! Bulk insertion ([`Delaunay::new`]) takes the points in a biased randomised insertion order
-//! ([`sort`]): random rounds of doubling size, each sorted along a Hilbert curve, so that each
+//! (module `sort`): random rounds of doubling size, each sorted along a Hilbert curve, so that each
 //! walk is short and the cavities stay small; the randomness has a fixed seed, so the same
 //! input gives the same tetrahedra, byte for byte. [`Delaunay::insert`] adds one point.
 //!
@@ -131,7 +131,7 @@ pub enum InsertError {
 }
 
 impl Delaunay {
-    /// The Delaunay tetrahedralisation of `points`, inserted in the order of [`sort`]. Vertex
+    /// The Delaunay tetrahedralisation of `points`, inserted in the order of module `sort`. Vertex
     /// `v` is `points[v]`; points equal to an earlier inserted one are left out
     /// ([`Delaunay::duplicates`]).
     pub fn new(points: &[DVec3]) -> Result<Delaunay, DelaunayError> {
@@ -253,7 +253,8 @@ impl Delaunay {
         (cell[0] != FREE).then_some(cell)
     }
 
-    /// The tetrahedra across the faces opposite each vertex of tetrahedron `t`.
+    /// The tetrahedra across the faces opposite each vertex of tetrahedron `t` (meaningless
+    /// for a free slot).
     pub fn neighbours(&self, t: u32) -> [u32; 4] {
         self.cells[t as usize].neighbours
     }
