@@ -26,9 +26,11 @@
 //!   infinite vertex comes first in the perturbation order, before every point).
 //! - The cavity is star-shaped from the point: a boundary face whose new tetrahedron would not
 //!   be positive by [`orient3d`] has the tetrahedron across it added to the cavity
-//!   ([`Delaunay::cavity_repairs`] counts them; the perturbation leaves none to repair).
-//!   So every finite tetrahedron is positive: `orient3d(a, b, c, d)` is `Positive`, the
-//!   convention of [`crate::fill::CoreTets`] and [`TetMesh`].
+//!   ([`Delaunay::cavity_repairs`] counts them; the perturbation leaves none to repair). A
+//!   face between two strict verdicts (no tie broken) needs no test: the point is then
+//!   strictly on the cavity's side of it. So every finite tetrahedron is positive:
+//!   `orient3d(a, b, c, d)` is `Positive`, the convention of [`crate::fill::CoreTets`] and
+//!   [`TetMesh`].
 //! - A point equal to a vertex is not inserted ([`Delaunay::duplicates`],
 //!   [`InsertError::Duplicate`]). The first tetrahedron is the first four points in insertion
 //!   order that are not coplanar (exact tests); all points coplanar is an error.
@@ -37,6 +39,10 @@
 //! (module `sort`): random rounds of doubling size, each sorted along a Hilbert curve, so that each
 //! walk is short and the cavities stay small; the randomness has a fixed seed, so the same
 //! input gives the same tetrahedra, byte for byte. [`Delaunay::insert`] adds one point.
+//!
+//! The predicates are exact while none of their floating-point products overflows or
+//! underflows: the insphere determinant is of degree 5 in the coordinates relative to the
+//! tested point, so those must stay between about 1e-60 and 1e60 in magnitude.
 //!
 //! Left for the next steps of the core mesher: recovery of the boundary triangles (flips and
 //! Steiner points off the front, keeping every front triangle as a face), removal of the
