@@ -269,8 +269,9 @@ impl Delaunay {
             let slot = match s.cavity.get(k) {
                 Some(&slot) => slot,
                 None => self.free.pop().unwrap_or_else(|| {
+                    let slot = u32::try_from(self.cells.len()).ok().filter(|&t| t < FREE);
                     self.cells.push(Cell::FREE);
-                    self.cells.len() as u32 - 1
+                    slot.expect("fewer than 2^32 - 2 tetrahedra")
                 }),
             };
             self.cells[slot as usize].vertices = face.cell;

@@ -225,6 +225,24 @@ fn tets_by_corners(d: &Delaunay) -> Vec<[[u64; 3]; 4]> {
     tets
 }
 
+/// The tetrahedralisation of `points`; none when they are all in one plane (a few grid or
+/// sphere nodes can be), which is then checked.
+fn tetrahedralise(points: &[DVec3]) -> Result<Option<Delaunay>, TestCaseError> {
+    match Delaunay::new(points) {
+        Ok(d) => Ok(Some(d)),
+        Err(DelaunayError::Flat(_)) => {
+            let n = points.len();
+            let spans = |i: usize, j: usize, k: usize| {
+                (k + 1..n).any(|l| orient3d(points[i], points[j], points[k], points[l]) != Sign::Zero)
+            };
+            let tetrahedron = (0..n).any(|i| (i + 1..n).any(|j| (j + 1..n).any(|k| spans(i, j, k))));
+            prop_assert!(!tetrahedron, "four of the points refused as flat span a tetrahedron");
+            Ok(None)
+        }
+        Err(e) => Err(TestCaseError::fail(e.to_string())),
+    }
+}
+
 fn cloud_strategy() -> impl Strategy<Value = Cloud> {
     prop_oneof![
         Just(Cloud::Uniform),
@@ -245,7 +263,7 @@ proptest! {
     #[test]
     fn small_clouds_are_delaunay(kind in cloud_strategy(), n in 5usize..=60, seed in any::<u64>()) {
         let points = cloud(kind, n, seed);
-        let d = Delaunay::new(&points).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let Some(d) = tetrahedralise(&points)? else { return Ok(()) };
         prop_assert_eq!(check(&d, true), Ok(()));
         prop_assert_eq!(d.cavity_repairs(), 0);
     }
@@ -255,7 +273,7 @@ proptest! {
     #[test]
     fn one_by_one_gives_the_bulk_result(kind in cloud_strategy(), n in 8usize..=60, seed in any::<u64>()) {
         let points = cloud(kind, n, seed);
-        let bulk = Delaunay::new(&points).map_err(|e| TestCaseError::fail(e.to_string()))?;
+        let Some(bulk) = tetrahedralise(&points)? else { return Ok(()) };
         let start = first_tetrahedron(&points).expect("not flat");
         let mut one = Delaunay::new(&start.map(|v| points[v as usize])).expect("a tetrahedron");
         for v in (0..n as u32).filter(|v| !start.contains(v)) {
