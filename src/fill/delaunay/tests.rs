@@ -382,16 +382,33 @@ fn insert_numbers_points_and_refuses_duplicates() {
     assert_eq!(check(&d, true), Ok(()));
 }
 
+/// The improvement operators run on the tetrahedra (every point fixed: flips and edge
+/// removals only): they stay positive and fill the hull.
 #[test]
 fn tet_mesh_gets_every_tetrahedron() {
     let d = Delaunay::new(&cloud(Cloud::Uniform, 300, 11)).unwrap();
-    let mesh = d.to_tet_mesh(0);
+    let mut mesh = d.to_tet_mesh(300);
     let mut from_mesh: Vec<[u32; 4]> = mesh.tets().collect();
     let mut ours: Vec<[u32; 4]> = d.tets().collect();
     from_mesh.sort_unstable();
     ours.sort_unstable();
     assert_eq!(from_mesh, ours);
-    assert_eq!(mesh.points.len(), 300);
+    let volume = |tets: &[[u32; 4]]| -> f64 {
+        let corners = |t: &[u32; 4]| t.map(|v| d.points()[v as usize]);
+        tets.iter().map(corners).map(|[a, b, c, e]| tet_signed_volume(a, b, c, e)).sum()
+    };
+    let options = crate::fill::improve::ImproveOptions { insert_points: false, ..Default::default() };
+    let stats = mesh.improve(&options);
+    let (points, tets) = mesh.into_parts();
+    assert_eq!(points, d.points());
+    let positive = |t: &[u32; 4]| {
+        let [a, b, c, e] = t.map(|v| points[v as usize]);
+        orient3d(a, b, c, e) == Sign::Positive
+    };
+    assert!(tets.iter().all(positive), "{stats:?}");
+    assert!(stats.flips_23 + stats.flips_32 + stats.flips_44 + stats.edge_removals > 0, "{stats:?}");
+    let (before, after) = (volume(&ours), volume(&tets));
+    assert!((after - before).abs() < 1e-12 * before, "{before} -> {after}");
 }
 
 /// On points in general position the Delaunay tetrahedralisation is unique: TetGen's is ours.
