@@ -73,6 +73,7 @@ fn shell(n: usize, depth: f64) -> Vec<DVec3> {
 /// Our kernel and TetGen's on `points`, `runs` times each, alternating.
 fn compare(name: &str, runs: usize, points: &[DVec3]) {
     let mut ours = Timing::default();
+    #[cfg_attr(not(feature = "tetgen"), allow(unused_mut))]
     let mut theirs = Timing::default();
     for _ in 0..runs {
         ours.time(|| Delaunay::new(points).expect("not flat").tets().collect::<Vec<_>>().len());
