@@ -80,27 +80,19 @@ struct BlmeshTetgenResult {
   tetgenio out;
 };
 
-// Run TetGen. On success (return 0) `*result` holds the output; on failure it is null and
-// `message` (capacity `message_capacity`, may be null) says what happened.
-int blmesh_tetgen_run(int n_points, const double *points, const double *sizes, int n_triangles,
-                      const int *triangles, const int *markers, int n_holes, const double *holes,
-                      const char *switches, BlmeshTetgenResult **result, char *message,
-                      size_t message_capacity) {
-  if (result == nullptr) {
-    copy_message(message, message_capacity, "no place for the result");
-    return TG_BAD_ARGUMENT;
-  }
-  *result = nullptr;
-  if (n_points < 4 || n_triangles < 4 || n_holes < 0 || points == nullptr || triangles == nullptr ||
-      markers == nullptr || switches == nullptr || (n_holes > 0 && holes == nullptr) ||
-      std::strlen(switches) >= 1000) {
-    copy_message(message, message_capacity, "bad arguments");
-    return TG_BAD_ARGUMENT;
-  }
+}  // extern "C"
+
+namespace {
+
+// Run TetGen on the input that `load` puts in a tetgenio. On success (return 0) `*result` holds
+// the output; on failure it is null and `message` says what happened.
+template <typename Load>
+int run_tetgen(Load load, const char *switches, BlmeshTetgenResult **result, char *message,
+               size_t message_capacity) {
   BlmeshTetgenResult *owned = nullptr;
   try {
     tetgenio in;
-    load_input(in, n_points, points, sizes, n_triangles, triangles, markers, n_holes, holes);
+    load(in);
     owned = new BlmeshTetgenResult();
     char switch_buffer[1024];
     std::strncpy(switch_buffer, switches, sizeof switch_buffer - 1);
@@ -121,6 +113,55 @@ int blmesh_tetgen_run(int n_points, const double *points, const double *sizes, i
     copy_message(message, message_capacity, "unknown C++ exception");
     return TG_UNKNOWN_EXCEPTION;
   }
+}
+
+}  // namespace
+
+extern "C" {
+
+// Run TetGen. On success (return 0) `*result` holds the output; on failure it is null and
+// `message` (capacity `message_capacity`, may be null) says what happened.
+int blmesh_tetgen_run(int n_points, const double *points, const double *sizes, int n_triangles,
+                      const int *triangles, const int *markers, int n_holes, const double *holes,
+                      const char *switches, BlmeshTetgenResult **result, char *message,
+                      size_t message_capacity) {
+  if (result == nullptr) {
+    copy_message(message, message_capacity, "no place for the result");
+    return TG_BAD_ARGUMENT;
+  }
+  *result = nullptr;
+  if (n_points < 4 || n_triangles < 4 || n_holes < 0 || points == nullptr || triangles == nullptr ||
+      markers == nullptr || switches == nullptr || (n_holes > 0 && holes == nullptr) ||
+      std::strlen(switches) >= 1000) {
+    copy_message(message, message_capacity, "bad arguments");
+    return TG_BAD_ARGUMENT;
+  }
+  auto load = [&](tetgenio &in) {
+    load_input(in, n_points, points, sizes, n_triangles, triangles, markers, n_holes, holes);
+  };
+  return run_tetgen(load, switches, result, message, message_capacity);
+}
+
+// The Delaunay tetrahedralization of a bare point set (switches without `p`), as
+// blmesh_tetgen_run.
+int blmesh_tetgen_points(int n_points, const double *points, const char *switches,
+                         BlmeshTetgenResult **result, char *message, size_t message_capacity) {
+  if (result == nullptr) {
+    copy_message(message, message_capacity, "no place for the result");
+    return TG_BAD_ARGUMENT;
+  }
+  *result = nullptr;
+  if (n_points < 4 || points == nullptr || switches == nullptr || std::strlen(switches) >= 1000) {
+    copy_message(message, message_capacity, "bad arguments");
+    return TG_BAD_ARGUMENT;
+  }
+  auto load = [&](tetgenio &in) {
+    in.firstnumber = 0;
+    in.numberofpoints = n_points;
+    in.pointlist = new REAL[3 * (size_t)n_points];
+    std::memcpy(in.pointlist, points, sizeof(double) * 3 * (size_t)n_points);
+  };
+  return run_tetgen(load, switches, result, message, message_capacity);
 }
 
 // Sizes of the output: points, tetrahedra, boundary triangles.

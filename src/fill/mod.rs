@@ -7,6 +7,7 @@
 //! adds the farfield ([`farfield`]); has a [`CoreMesher`] fill the region with tetrahedra that
 //! keep every boundary triangle exactly; and checks that they do before merging.
 
+pub mod delaunay;
 pub mod farfield;
 mod front;
 pub mod grading;

@@ -202,6 +202,14 @@ mod ffi {
             message: *mut c_char,
             message_capacity: usize,
         ) -> c_int;
+        pub fn blmesh_tetgen_points(
+            n_points: c_int,
+            points: *const f64,
+            switches: *const c_char,
+            result: *mut *mut BlmeshTetgenResult,
+            message: *mut c_char,
+            message_capacity: usize,
+        ) -> c_int;
         pub fn blmesh_tetgen_counts(
             result: *const BlmeshTetgenResult,
             n_points: *mut c_int,
@@ -346,7 +354,56 @@ fn run_here(input: &Input, switches: &str) -> Result<Output, FillError> {
     if code != 0 || result.is_null() {
         return Err(tetgen_error(code, &message));
     }
-    let guard = ResultGuard(result);
+    copy_out(ResultGuard(result))
+}
+
+/// TetGen's Delaunay tetrahedralisation of a bare point set, for comparing Delaunay kernels:
+/// the tetrahedra, indices into `points`, as TetGen orders their vertices (positive by our
+/// `orient3d`, not checked here). Switches `zQF`: no facets (no `p`), no faces written. It runs in this process, not in a child: the answer (millions of tetrahedra)
+/// would cost more to send through the pipe than to compute, which would blur the comparison;
+/// so a crash of TetGen ends the program.
+pub fn delaunay_of_points(points: &[DVec3]) -> Result<Vec<[u32; 4]>, FillError> {
+    let n = c_int::try_from(points.len())
+        .map_err(|_| FillError::Input(format!("{} points are too many for TetGen", points.len())))?;
+    if let Some(p) = points.iter().position(|p| !p.is_finite()) {
+        return Err(FillError::Input(format!("point {p} is not finite: {:?}", points[p])));
+    }
+    let coordinates: Vec<f64> = points.iter().flat_map(|p| p.to_array()).collect();
+    let _one_at_a_time = TETGEN.lock().unwrap_or_else(|poisoned| poisoned.into_inner());
+    let mut result: *mut ffi::BlmeshTetgenResult = std::ptr::null_mut();
+    let mut message = [0 as c_char; 256];
+    // SAFETY: `coordinates` holds 3 values per point; the switches are NUL-terminated and
+    // `message` has the capacity passed. The shim catches every C++ exception.
+    let code = unsafe {
+        ffi::blmesh_tetgen_points(
+            n,
+            coordinates.as_ptr(),
+            c"zQF".as_ptr(),
+            &mut result,
+            message.as_mut_ptr(),
+            message.len(),
+        )
+    };
+    if code != 0 || result.is_null() {
+        return Err(tetgen_error(code, &message));
+    }
+    let output = copy_out(ResultGuard(result))?;
+    let index = |v: c_int| u32::try_from(v).ok().filter(|&v| (v as usize) < points.len());
+    output
+        .tets
+        .iter()
+        .map(|t| {
+            let checked = [index(t[0]), index(t[1]), index(t[2]), index(t[3])];
+            match checked {
+                [Some(a), Some(b), Some(c), Some(d)] => Ok([a, b, c, d]),
+                _ => Err(FillError::BadOutput(format!("TetGen tetrahedron {t:?} is out of range"))),
+            }
+        })
+        .collect()
+}
+
+/// Copy TetGen's output out of the shim's result, and free it.
+fn copy_out(guard: ResultGuard) -> Result<Output, FillError> {
     let (mut n_points, mut n_tets, mut n_triangles) = (0 as c_int, 0 as c_int, 0 as c_int);
     // SAFETY: `guard.0` is a live result; the three out-pointers are valid for writes.
     unsafe { ffi::blmesh_tetgen_counts(guard.0, &mut n_points, &mut n_tets, &mut n_triangles) };
