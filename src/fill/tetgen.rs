@@ -359,9 +359,10 @@ fn run_here(input: &Input, switches: &str) -> Result<Output, FillError> {
 
 /// TetGen's Delaunay tetrahedralisation of a bare point set, for comparing Delaunay kernels:
 /// the tetrahedra, indices into `points`, as TetGen orders their vertices (positive by our
-/// `orient3d`, not checked here). Switches `zQF`: no facets (no `p`), no faces written. It runs in this process, not in a child: the answer (millions of tetrahedra)
-/// would cost more to send through the pipe than to compute, which would blur the comparison;
-/// so a crash of TetGen ends the program.
+/// `orient3d`, not checked here). Switches `zQF`: no facets (no `p`), no faces written. It runs
+/// in this process, not in a child: the answer (millions of tetrahedra) would cost more to send
+/// through the pipe than to compute, which would blur the comparison; so a crash of TetGen ends
+/// the program.
 pub fn delaunay_of_points(points: &[DVec3]) -> Result<Vec<[u32; 4]>, FillError> {
     let n = c_int::try_from(points.len())
         .map_err(|_| FillError::Input(format!("{} points are too many for TetGen", points.len())))?;

@@ -145,8 +145,8 @@ pub fn wall_normals_of_layered(
     let is_cut = |e: u32| is_fan_edge(e) || (uses_layered(e).any(|l| l) && uses_layered(e).any(|l| !l));
     // Per (vertex, fan edge): the sector columns on the edge's t1 side (index 0) and t2 side.
     let mut fan_ends: Vec<Vec<(u32, u32, u32)>> = vec![Vec::new(); surface.points.len()];
-    let mut roots = ridge_roots::find(surface, topology, features, &is_cut);
-    let mut next_root = roots.iter_mut().peekable();
+    let roots = ridge_roots::find(surface, topology, features, &is_cut);
+    let mut next_root = roots.iter().peekable();
     for v in 0..surface.points.len() as u32 {
         if topology.vertex_triangles(v).is_empty() {
             continue;

@@ -34,8 +34,6 @@ pub(super) struct RidgeRoot {
     seams: Vec<(u32, u32)>,
     /// The most normal direction of the floor's triangles.
     floor_normal: DVec3,
-    /// The sector columns of `side_a` and `side_b` ([`RidgeRoot::side_columns`]).
-    columns: (u32, u32),
 }
 
 /// The ridge roots of the wall, sorted by vertex: vertices whose only cut edge (`is_cut`) is a
@@ -109,7 +107,7 @@ fn root_at(
     }
     let normals: Vec<DVec3> = floor.iter().map(|&(t, _)| surface.triangle_normal(t as usize)).collect();
     let floor_normal = most_normal(&normals)?.direction;
-    Some(RidgeRoot { vertex: v, ridge, side_a, floor, side_b, seams, floor_normal, columns: (0, 0) })
+    Some(RidgeRoot { vertex: v, ridge, side_a, floor, side_b, seams, floor_normal })
 }
 
 impl RidgeRoot {
@@ -117,7 +115,7 @@ impl RidgeRoot {
     /// sector columns on either side of the ridge in `ends` (t1's side first, as
     /// [`super::sector_columns`] records them).
     pub fn side_columns(
-        &mut self,
+        &self,
         surface: &Surface,
         topology: &Topology,
         out: &mut WallNormals,
@@ -136,7 +134,6 @@ impl RidgeRoot {
         };
         let a = side_column(&self.side_a, out);
         let b = side_column(&self.side_b, out);
-        self.columns = (a, b);
         // Side a follows the ridge in the ring, so it is t1's side where the ridge runs from
         // this vertex.
         let from_here = topology.edges[self.ridge as usize][0] == self.vertex;
@@ -172,7 +169,9 @@ impl RidgeRoot {
     /// most nearly along its middle, no earlier in the fan than its predecessor's in the ring,
     /// and close the front over every seam whose two triangles took different columns.
     pub fn close_onto_floor(&self, surface: &Surface, fan: &[u32], out: &mut WallNormals) {
-        let fan: Vec<u32> = if fan.first() == Some(&self.columns.0) {
+        let (t, corner) = self.side_a[0];
+        let side_a_column = out.triangle_columns[t as usize][corner];
+        let fan: Vec<u32> = if fan.first() == Some(&side_a_column) {
             fan.to_vec()
         } else {
             fan.iter().rev().copied().collect()
