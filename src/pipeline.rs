@@ -86,6 +86,9 @@ pub struct InputSummary {
     pub vertices: usize,
     pub patches: Vec<String>,
     pub body_size: f64,
+    /// What the wall's own triangulation gives the first prisms' lateral faces: their
+    /// non-orthogonality, which every layer of full prisms over an edge repeats.
+    pub wall_non_orthogonality: quality::fv::WallNonOrthogonality,
 }
 
 #[derive(Clone, Debug, Serialize)]
@@ -193,6 +196,8 @@ pub fn run(
         let features = Features::compute(&surface, &topology, config.feature_angle());
         (topology, features)
     });
+    let wall_non_orthogonality = quality::fv::wall_non_orthogonality(&surface, &topology, &layered_patch);
+    warnings.extend(wall_non_orthogonality_warning(&wall_non_orthogonality));
     let wall_normals = progress.stage(&mut timings, "normals", || {
         let fan_angle = config.fan_angle();
         let mut n =
@@ -247,6 +252,7 @@ pub fn run(
             vertices: surface.points.len(),
             patches: surface.patch_names.clone(),
             body_size,
+            wall_non_orthogonality,
         },
         features: features.counts.clone(),
         normals: wall_normals.stats.clone(),
@@ -569,6 +575,23 @@ fn not_planar_warnings(surface: &Surface, layered_patch: &[bool], planes: &[Opti
         .collect()
 }
 
+/// A warning when the wall's own triangles make lateral prism faces that a solver's
+/// non-orthogonal correction can hardly mend: the layers repeat them, only a better wall
+/// triangulation removes them.
+fn wall_non_orthogonality_warning(wall: &quality::fv::WallNonOrthogonality) -> Option<String> {
+    let at = wall.worst_at.filter(|_| wall.edges_above_85 > 0)?;
+    Some(format!(
+        "{} wall edges (of {}) lie between triangles so thin side by side that the prisms over them \
+         have lateral faces above {} deg non-orthogonal in every layer (worst {:.1} deg at {}): \
+         the wall's triangulation sets them",
+        wall.edges_above_85,
+        wall.edges,
+        quality::fv::SOLVER_LIMIT_NON_ORTHOGONALITY,
+        wall.max,
+        format_point(DVec3::from(at))
+    ))
+}
+
 fn layer_summary(
     layered: &layers::Layers,
     surface: &Surface,
@@ -785,8 +808,8 @@ impl std::fmt::Display for MeshReport {
         let v = &self.check.fv;
         writeln!(
             f,
-            "fv        non-orthogonality max {:.1} mean {:.1} deg ({} faces above 70, {} above 80), skewness max {:.2}, {} wrong face pyramids",
-            v.non_orthogonality_max, v.non_orthogonality_mean, v.faces_above_70, v.faces_above_80, v.skewness_max, v.wrong_face_pyramids
+            "fv        non-orthogonality max {:.1} mean {:.1} deg ({} faces above 70, {} above 85), skewness max {:.2}, {} wrong face pyramids",
+            v.non_orthogonality_max, v.non_orthogonality_mean, v.faces_above_70, v.faces_above_85, v.skewness_max, v.wrong_face_pyramids
         )?;
         for w in &self.warnings {
             writeln!(f, "warning   {w}")?;

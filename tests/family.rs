@@ -84,11 +84,12 @@ fn pipeline_results() -> Vec<SeedResult> {
 }
 
 #[test]
-fn family_meshes_pass_the_checker_on_every_seed() {
+fn family_meshes_pass_the_checker_and_a_solver_on_every_seed() {
     let results = pipeline_results();
     for r in &results {
         let m = r.measures.as_ref().unwrap_or_else(|e| panic!("{} seed {}: {e}", r.family, r.seed));
         assert!(m.valid && m.conforming && m.volume_identity, "{}", describe(r));
+        assert!(m.solver_rejection.is_none(), "{}: {:?}", describe(r), m.solver_rejection);
     }
 }
 

@@ -29,10 +29,15 @@
 
 use rayon::prelude::*;
 
+use serde::Serialize;
+
 use super::fv_report::{FaceSides, FvReport, FvTally};
+pub use super::fv_report::{SEVERE_NON_ORTHOGONALITY, SOLVER_LIMIT_NON_ORTHOGONALITY};
 use super::validity::gather;
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, CellNumbering, FaceTable, VolumeMesh};
+use crate::surface::topology::Topology;
+use crate::surface::Surface;
 
 /// A face's centre, area vector and the area of its triangle fan (for the flatness).
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -238,6 +243,67 @@ pub fn measure(mesh: &VolumeMesh, table: &FaceTable) -> FvReport {
     });
     let all = cells.par_iter().fold(FvTally::default, |tally, c| tally.add_cell(c));
     faces.chain(all).reduce(FvTally::default, FvTally::merge).finish()
+}
+
+/// What a wall's own triangulation gives the lateral faces of the prisms extruded from it
+/// ([`wall_non_orthogonality`]).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct WallNonOrthogonality {
+    /// Edges between two triangles that get layers.
+    pub edges: usize,
+    /// Degrees; 0 without such edges.
+    pub max: f64,
+    pub edges_above_70: usize,
+    pub edges_above_85: usize,
+    /// The middle of the worst edge.
+    pub worst_at: Option<[f64; 3]>,
+}
+
+/// The non-orthogonality of the lateral faces of thin prisms over the wall's edges: over an
+/// edge shared by two triangles that get layers, the angle between the lateral face's area
+/// vector (the edge crossed with the mean of the triangles' unit normals) and the line between
+/// the triangles' centroids, the limit of the face's non-orthogonality as the prisms' height
+/// goes to 0. It is set by the triangulation alone (two needle triangles side by side make it
+/// near 90 degrees), so every layer of full prisms over the edge repeats it, whatever the
+/// layers do: only another wall triangulation changes it.
+pub fn wall_non_orthogonality(
+    surface: &Surface,
+    topology: &Topology,
+    layered_patch: &[bool],
+) -> WallNonOrthogonality {
+    let layered = |t: u32| layered_patch[surface.triangle_patch[t as usize] as usize];
+    let at = |v: u32| surface.points[v as usize];
+    let centroid = |t: u32| surface.triangles[t as usize].map(at).iter().sum::<DVec3>() / 3.0;
+    let normal = |t: u32| {
+        let [a, b, c] = surface.triangles[t as usize].map(at);
+        crate::geometry::triangle_area_vector(a, b, c).normalize_or_zero()
+    };
+    let angles: Vec<(f64, u32)> = (0..topology.edge_count() as u32)
+        .into_par_iter()
+        .filter_map(|e| {
+            let [u, w] = topology.edge_uses(e) else { return None };
+            let (s, t) = (u.triangle, w.triangle);
+            if !(layered(s) && layered(t)) {
+                return None;
+            }
+            let [a, b] = topology.edges[e as usize].map(at);
+            let face = (b - a).cross(normal(s) + normal(t));
+            let across = centroid(t) - centroid(s);
+            let angle = angle_deg(face, across);
+            Some((angle.min(180.0 - angle), e))
+        })
+        .collect();
+    let worst = angles.iter().max_by(|x, y| x.0.total_cmp(&y.0));
+    WallNonOrthogonality {
+        edges: angles.len(),
+        max: worst.map_or(0.0, |w| w.0),
+        edges_above_70: angles.iter().filter(|a| a.0 > SEVERE_NON_ORTHOGONALITY).count(),
+        edges_above_85: angles.iter().filter(|a| a.0 > SOLVER_LIMIT_NON_ORTHOGONALITY).count(),
+        worst_at: worst.map(|&(_, e)| {
+            let [a, b] = topology.edges[e as usize].map(at);
+            (0.5 * (a + b)).to_array()
+        }),
+    }
 }
 
 #[cfg(test)]

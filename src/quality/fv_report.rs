@@ -15,6 +15,10 @@ pub const WORST_FACES: usize = 5;
 /// Non-orthogonality (degrees) above which checkMesh calls a face severely non-orthogonal.
 pub const SEVERE_NON_ORTHOGONALITY: f64 = 70.0;
 
+/// Non-orthogonality (degrees) above which a face is counted as one a solver's non-orthogonal
+/// correction can hardly mend (its correction term grows as `tan` of the angle: 11 at 85).
+pub const SOLVER_LIMIT_NON_ORTHOGONALITY: f64 = 85.0;
+
 /// Skewness above which checkMesh calls an interior face highly skewed.
 pub const HIGH_SKEWNESS: f64 = 4.0;
 
@@ -72,6 +76,8 @@ pub struct FvReport {
     pub non_orthogonality_mean: f64,
     pub faces_above_70: usize,
     pub faces_above_80: usize,
+    /// Interior faces above [`SOLVER_LIMIT_NON_ORTHOGONALITY`].
+    pub faces_above_85: usize,
     /// Interior faces a solver cannot use: the centre line meets the face at 90 degrees or more.
     pub faces_at_or_above_90: usize,
     /// Degrees, over the boundary faces (owner centre to face centre).
@@ -104,6 +110,7 @@ impl Default for FvReport {
             non_orthogonality_mean: 0.0,
             faces_above_70: 0,
             faces_above_80: 0,
+            faces_above_85: 0,
             faces_at_or_above_90: 0,
             boundary_non_orthogonality_max: 0.0,
             skewness_max: 0.0,
@@ -183,6 +190,7 @@ impl FvTally {
             self.non_orthogonality_sum += angle;
             r.faces_above_70 += usize::from(angle > SEVERE_NON_ORTHOGONALITY);
             r.faces_above_80 += usize::from(angle > 80.0);
+            r.faces_above_85 += usize::from(angle > SOLVER_LIMIT_NON_ORTHOGONALITY);
             r.faces_at_or_above_90 += usize::from(angle >= 90.0);
             r.faces_skewness_above_4 += usize::from(m.skewness > HIGH_SKEWNESS);
             let (a, b) = (sides.owner.min(neighbour), sides.owner.max(neighbour));
@@ -222,6 +230,7 @@ impl FvTally {
         r.non_orthogonality_max = r.non_orthogonality_max.max(o.non_orthogonality_max);
         r.faces_above_70 += o.faces_above_70;
         r.faces_above_80 += o.faces_above_80;
+        r.faces_above_85 += o.faces_above_85;
         r.faces_at_or_above_90 += o.faces_at_or_above_90;
         r.boundary_non_orthogonality_max =
             r.boundary_non_orthogonality_max.max(o.boundary_non_orthogonality_max);
@@ -284,13 +293,14 @@ impl fmt::Display for FvReport {
         writeln!(
             f,
             "fv: {} faces ({} interior); non-orthogonality max {:.2} mean {:.2} deg, {} above 70, {} above \
-             80, {} at 90 or more; skewness max {:.3}, {} above 4; {} wrong face pyramids",
+             80, {} above 85, {} at 90 or more; skewness max {:.3}, {} above 4; {} wrong face pyramids",
             self.faces,
             self.interior_faces,
             self.non_orthogonality_max,
             self.non_orthogonality_mean,
             self.faces_above_70,
             self.faces_above_80,
+            self.faces_above_85,
             self.faces_at_or_above_90,
             self.skewness_max,
             self.faces_skewness_above_4,

@@ -351,6 +351,7 @@ fn the_report_serialises_the_finite_volume_measures() {
         "non_orthogonality_mean",
         "faces_above_70",
         "faces_above_80",
+        "faces_above_85",
         "skewness_max",
         "faces_skewness_above_4",
         "wrong_face_pyramids",

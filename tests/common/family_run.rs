@@ -33,6 +33,17 @@ pub struct Measures {
     pub valid: bool,
     pub conforming: bool,
     pub volume_identity: bool,
+    /// What a finite-volume solver would reject (a wrong face pyramid, a face at 90 degrees
+    /// non-orthogonality or more), if anything.
+    pub solver_rejection: Option<String>,
+    /// The checker's finite-volume figures over the interior faces (non-orthogonality in
+    /// degrees), and what the wall's own triangulation gives the prisms' lateral faces.
+    pub non_orthogonality_max: f64,
+    pub faces_above_70_share: f64,
+    pub faces_above_85: usize,
+    pub skewness_max: f64,
+    pub wall_edges_above_70: usize,
+    pub wall_edges_above_85: usize,
 }
 
 /// The spec's first layer height as a fraction of the bounding-box diagonal.
@@ -62,6 +73,7 @@ pub fn run_seed(family: Family, seed: u64, fineness: f64) -> SeedResult {
     let seconds = start.elapsed().as_secs_f64();
     let measures = out.map_err(|e| e.to_string()).map(|out| {
         let r = &out.report;
+        let (fv, wall) = (&r.check.fv, &r.input.wall_non_orthogonality);
         Measures {
             near_concave_coverage: r.layers.near_concave_coverage,
             near_concave_vertices: r.layers.near_concave_vertices,
@@ -70,6 +82,13 @@ pub fn run_seed(family: Family, seed: u64, fineness: f64) -> SeedResult {
             valid: r.check.is_valid(),
             conforming: r.check.conformity.errors == 0,
             volume_identity: r.check.volume_identity_holds(),
+            solver_rejection: r.check.fv.rejection(),
+            non_orthogonality_max: fv.non_orthogonality_max,
+            faces_above_70_share: fv.faces_above_70 as f64 / fv.interior_faces.max(1) as f64,
+            faces_above_85: fv.faces_above_85,
+            skewness_max: fv.skewness_max,
+            wall_edges_above_70: wall.edges_above_70,
+            wall_edges_above_85: wall.edges_above_85,
         }
     });
     SeedResult { family: family.name(), seed, triangles, seconds, measures }
@@ -80,7 +99,7 @@ pub fn describe(r: &SeedResult) -> String {
     match &r.measures {
         Ok(m) => format!(
             "{} seed {}: {} triangles, near-concave {:.2}% of {}, full {:.2}%, core min dihedral {:.2} deg, \
-             valid {}, {:.1} s",
+             valid {}, non-orthogonality max {:.1} deg ({} faces above 85, wall edges above 85: {}), {:.1} s",
             r.family,
             r.seed,
             r.triangles,
@@ -89,6 +108,9 @@ pub fn describe(r: &SeedResult) -> String {
             100.0 * m.full_coverage,
             m.core_min_dihedral,
             m.valid,
+            m.non_orthogonality_max,
+            m.faces_above_85,
+            m.wall_edges_above_85,
             r.seconds
         ),
         Err(e) => format!(
@@ -99,7 +121,7 @@ pub fn describe(r: &SeedResult) -> String {
 }
 
 /// Median, 5th percentile (nearest rank) and worst of `values`; `low_is_bad` says which end
-/// is the worst.
+/// is the worst (when high is bad, `p5` is the 95th percentile).
 #[derive(Clone, Copy, Debug)]
 pub struct Spread {
     pub median: f64,
@@ -156,7 +178,58 @@ pub fn table(results: &[SeedResult]) -> String {
         out += &row(family, &rows);
         out.push('\n');
     }
-    out + "* over the seeds with wall vertices near a concave ridge\n"
+    out += "* over the seeds with wall vertices near a concave ridge\n\n";
+    out + &fv_table(&families, &all)
+}
+
+/// The finite-volume figures of `results` as a table: one row per family, then `all`.
+fn fv_table(families: &[&str], all: &[&SeedResult]) -> String {
+    let mut out = format!(
+        "{:<13} | {:^17} | {:^20} | {:^17} | {:^17} | {:^17} | {}\n{:<13} | {:^17} | {:^20} | {:^17} | {:^17} | {:^17} |\n",
+        "family",
+        "non-orth max deg",
+        "faces above 70 %",
+        "faces above 85",
+        "skewness max",
+        "wall edges > 85 *",
+        "rejected **",
+        "",
+        "median  p95  max",
+        "median   p95    max",
+        "median  p95  max",
+        "median  p95  max",
+        "median  p95  max",
+    );
+    for family in families.iter().copied().chain(["all"]) {
+        let rows: Vec<&SeedResult> =
+            all.iter().copied().filter(|r| family == "all" || r.family == family).collect();
+        out += &fv_row(family, &rows);
+        out.push('\n');
+    }
+    out + "* the wall's own triangulation makes the prisms' lateral faces over these edges above 85 deg\n\
+           ** meshes a finite-volume solver rejects (a wrong face pyramid, a face at 90 deg or more)\n"
+}
+
+fn fv_row(name: &str, rows: &[&SeedResult]) -> String {
+    let measured: Vec<&Measures> = rows.iter().filter_map(|r| r.measures.as_ref().ok()).collect();
+    let pick = |f: fn(&Measures) -> f64| measured.iter().map(|m| f(m)).collect::<Vec<f64>>();
+    let spread = |values: Vec<f64>, scale: f64, width: usize, digits: usize| {
+        Spread::of(&values, false).map_or("-".to_owned(), |s| {
+            let cell = |x: f64| format!("{:>width$.digits$}", scale * x);
+            format!("{} {} {}", cell(s.median), cell(s.p5), cell(s.worst))
+        })
+    };
+    let rejected = measured.iter().filter(|m| m.solver_rejection.is_some()).count();
+    format!(
+        "{:<13} | {:^17} | {:^20} | {:^17} | {:^17} | {:^17} | {}",
+        name,
+        spread(pick(|m| m.non_orthogonality_max), 1.0, 5, 1),
+        spread(pick(|m| m.faces_above_70_share), 100.0, 6, 3),
+        spread(pick(|m| m.faces_above_85 as f64), 1.0, 5, 0),
+        spread(pick(|m| m.skewness_max), 1.0, 5, 2),
+        spread(pick(|m| m.wall_edges_above_85 as f64), 1.0, 5, 0),
+        rejected,
+    )
 }
 
 fn row(name: &str, rows: &[&SeedResult]) -> String {
