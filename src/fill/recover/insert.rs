@@ -1,0 +1,126 @@
+//! Insertion of the guide's points into the region's tetrahedra by Bowyer–Watson with the
+//! boundary triangles as walls: the cavity grows across interior faces only (the region's
+//! tetrahedra have none across a boundary triangle), then shrinks until it is star-shaped
+//! from the point (every face of it seen positively) and keeps every point.
+
+use std::collections::{BTreeSet, HashSet};
+
+use super::recovery::inward_faces;
+use crate::fill::improve::{Change, TetMesh, NO_TET};
+use crate::geometry::predicates::{insphere, orient3d, Sign};
+use crate::geometry::DVec3;
+
+/// Why a point was not inserted.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub(super) enum Skipped {
+    /// Outside the region or on its boundary.
+    Outside,
+    /// At a vertex.
+    Duplicate,
+}
+
+/// The live tetrahedron whose closure holds `p`: by a walk from `hint`, else by a search.
+fn locate(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
+    if mesh.is_alive(hint) {
+        if let Some(t) = mesh.locate(hint, p) {
+            return Some(t);
+        }
+    }
+    (0..mesh.slots() as u32).filter(|&t| mesh.is_alive(t)).find(|&t| {
+        let tet = mesh.tet(t);
+        inward_faces(tet).iter().all(|f| {
+            let [a, b, c] = f.map(|v| mesh.points[v as usize]);
+            orient3d(a, b, c, p) != Sign::Negative
+        })
+    })
+}
+
+/// Insert `p` (strictly inside the region) near tetrahedron `hint`; the new point's index.
+pub(super) fn insert_point(mesh: &mut TetMesh, hint: u32, p: DVec3) -> Result<u32, Skipped> {
+    let start = locate(mesh, hint, p).ok_or(Skipped::Outside)?;
+    let tet = mesh.tet(start);
+    if tet.iter().any(|&v| mesh.points[v as usize] == p) {
+        return Err(Skipped::Duplicate);
+    }
+    let x = |v: u32| mesh.points[v as usize];
+    // On a boundary triangle (a face with nothing across): not strictly inside.
+    for (i, f) in inward_faces(tet).iter().enumerate() {
+        if mesh.adjacent(start)[i] == NO_TET && orient3d(x(f[0]), x(f[1]), x(f[2]), p) == Sign::Zero {
+            return Err(Skipped::Outside);
+        }
+    }
+    let mut cavity: BTreeSet<u32> = BTreeSet::from([start]);
+    let mut stack = vec![start];
+    while let Some(t) = stack.pop() {
+        for n in mesh.adjacent(t) {
+            if n != NO_TET && !cavity.contains(&n) {
+                let [a, b, c, d] = mesh.tet(n).map(x);
+                if insphere(a, b, c, d, p) == Sign::Positive {
+                    cavity.insert(n);
+                    stack.push(n);
+                }
+            }
+        }
+    }
+    loop {
+        let faces = cavity_faces(mesh, &cavity);
+        // A face not seen from `p`: its tetrahedron leaves (the first holds `p`: a face of it
+        // that `p` is on has a tetrahedron holding `p` across, in the cavity, unless it is a
+        // boundary triangle).
+        let seen = |f: &[u32; 3]| orient3d(x(f[0]), x(f[1]), x(f[2]), p) == Sign::Positive;
+        match faces.iter().find(|(f, _)| !seen(f)) {
+            // Only on a face of the first tetrahedron: `p` is on the boundary.
+            Some(&(_, t)) if t == start => return Err(Skipped::Outside),
+            Some(&(_, t)) => {
+                cavity.remove(&t);
+                keep_connected(mesh, &mut cavity, start);
+                continue;
+            }
+            None => {}
+        }
+        let v = mesh.points.len() as u32;
+        let add: Vec<[u32; 4]> = faces.iter().map(|(f, _)| [f[0], f[1], f[2], v]).collect();
+        let kept: HashSet<u32> = add.iter().flatten().copied().collect();
+        let lost = cavity.iter().flat_map(|&t| mesh.tet(t)).find(|u| !kept.contains(u));
+        if let Some(u) = lost {
+            // A vertex inside the cavity: a tetrahedron at it leaves.
+            let Some(&t) = cavity.iter().find(|&&t| t != start && mesh.tet(t).contains(&u)) else {
+                return Err(Skipped::Outside);
+            };
+            cavity.remove(&t);
+            keep_connected(mesh, &mut cavity, start);
+            continue;
+        }
+        let remove: Vec<u32> = cavity.into_iter().collect();
+        mesh.apply(&Change::replacing(remove, add, Some((v, p))));
+        return Ok(v);
+    }
+}
+
+/// The faces of the cavity (normals into it) with the cavity's tetrahedron on each.
+fn cavity_faces(mesh: &TetMesh, cavity: &BTreeSet<u32>) -> Vec<([u32; 3], u32)> {
+    let mut faces = Vec::new();
+    for &t in cavity {
+        let inward = inward_faces(mesh.tet(t));
+        for (i, n) in mesh.adjacent(t).into_iter().enumerate() {
+            if !cavity.contains(&n) {
+                faces.push((inward[i], t));
+            }
+        }
+    }
+    faces
+}
+
+/// Keep only the tetrahedra of `cavity` connected to `start` through its faces.
+fn keep_connected(mesh: &TetMesh, cavity: &mut BTreeSet<u32>, start: u32) {
+    let mut reached = BTreeSet::from([start]);
+    let mut stack = vec![start];
+    while let Some(t) = stack.pop() {
+        for n in mesh.adjacent(t) {
+            if cavity.contains(&n) && reached.insert(n) {
+                stack.push(n);
+            }
+        }
+    }
+    *cavity = reached;
+}
