@@ -182,6 +182,33 @@ impl Recovery {
     }
 }
 
+impl Recovery {
+    /// Insert a Steiner point near the missing edge `ab`, off it into the region (along the
+    /// sum of its boundary triangles' normals), by Bowyer–Watson with the present boundary
+    /// triangles as walls, if one keeps the boundary; whether it did.
+    pub(super) fn steiner_near_edge(&mut self, [a, b]: [u32; 2], triangles: &[[u32; 3]]) -> bool {
+        let x = |v: u32| self.mesh.points[v as usize];
+        let normal = |t: &[u32; 3]| (x(t[1]) - x(t[0])).cross(x(t[2]) - x(t[0])).normalize_or_zero();
+        let at_edge = triangles.iter().filter(|t| t.contains(&a) && t.contains(&b));
+        let direction = at_edge.map(normal).sum::<DVec3>().normalize_or_zero();
+        let (middle, length) = (0.5 * (x(a) + x(b)), x(a).distance(x(b)));
+        let hint = self.mesh.ball(a).first().copied().unwrap_or(0);
+        let wall = |f: &[u32; 3]| self.triangles.contains(&crate::fill::sorted_triangle(*f));
+        for s in [0.2, 0.05, 0.01] {
+            let p = middle + s * length * direction;
+            if triangles.iter().any(|t| on_triangle(p, t.map(x))) {
+                continue;
+            }
+            let Ok((remove, add)) = super::insert::star_cavity(&self.mesh, hint, p, &wall) else { continue };
+            if self.keeps_boundary(&remove, &add) {
+                self.replace(remove, add, Some(p));
+                return true;
+            }
+        }
+        false
+    }
+}
+
 /// Whether `p` is on the closed triangle `t` (exact).
 pub(super) fn on_triangle(p: DVec3, t: [DVec3; 3]) -> bool {
     let lo = t[0].min(t[1]).min(t[2]);

@@ -37,6 +37,21 @@ fn locate(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
 
 /// Insert `p` (strictly inside the region) near tetrahedron `hint`; the new point's index.
 pub(super) fn insert_point(mesh: &mut TetMesh, hint: u32, p: DVec3) -> Result<u32, Skipped> {
+    let (remove, add) = star_cavity(mesh, hint, p, &|_| false)?;
+    let v = mesh.points.len() as u32;
+    mesh.apply(&Change::replacing(remove, add, Some((v, p))));
+    Ok(v)
+}
+
+/// The tetrahedra to replace to insert `p` near tetrahedron `hint`, and the cone from the new
+/// point (the next point index) replacing them; the cavity does not cross the faces without
+/// a tetrahedron across nor the `wall` faces, and `p` must be strictly off them.
+pub(super) fn star_cavity(
+    mesh: &TetMesh,
+    hint: u32,
+    p: DVec3,
+    wall: &dyn Fn(&[u32; 3]) -> bool,
+) -> Result<(Vec<u32>, Vec<[u32; 4]>), Skipped> {
     let start = locate(mesh, hint, p).ok_or(Skipped::Outside)?;
     let tet = mesh.tet(start);
     if tet.iter().any(|&v| mesh.points[v as usize] == p) {
@@ -45,15 +60,17 @@ pub(super) fn insert_point(mesh: &mut TetMesh, hint: u32, p: DVec3) -> Result<u3
     let x = |v: u32| mesh.points[v as usize];
     // On a boundary triangle (a face with nothing across): not strictly inside.
     for (i, f) in inward_faces(tet).iter().enumerate() {
-        if mesh.adjacent(start)[i] == NO_TET && orient3d(x(f[0]), x(f[1]), x(f[2]), p) == Sign::Zero {
+        let closed = mesh.adjacent(start)[i] == NO_TET || wall(f);
+        if closed && orient3d(x(f[0]), x(f[1]), x(f[2]), p) == Sign::Zero {
             return Err(Skipped::Outside);
         }
     }
     let mut cavity: BTreeSet<u32> = BTreeSet::from([start]);
     let mut stack = vec![start];
     while let Some(t) = stack.pop() {
-        for n in mesh.adjacent(t) {
-            if n != NO_TET && !cavity.contains(&n) {
+        let faces = inward_faces(mesh.tet(t));
+        for (i, n) in mesh.adjacent(t).into_iter().enumerate() {
+            if n != NO_TET && !cavity.contains(&n) && !wall(&faces[i]) {
                 let [a, b, c, d] = mesh.tet(n).map(x);
                 if insphere(a, b, c, d, p) == Sign::Positive {
                     cavity.insert(n);
@@ -91,9 +108,7 @@ pub(super) fn insert_point(mesh: &mut TetMesh, hint: u32, p: DVec3) -> Result<u3
             keep_connected(mesh, &mut cavity, start);
             continue;
         }
-        let remove: Vec<u32> = cavity.into_iter().collect();
-        mesh.apply(&Change::replacing(remove, add, Some((v, p))));
-        return Ok(v);
+        return Ok((cavity.into_iter().collect(), add));
     }
 }
 

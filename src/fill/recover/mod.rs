@@ -9,7 +9,9 @@
 //!    box's coplanar faces are flipped like any other).
 //! 2. Edge recovery ([`flip`], then [`cavity`]): each boundary edge that is not an edge is
 //!    crossed by fewer and fewer faces and edges by flips, else it is made by a cone from one
-//!    of its ends over the cavity around it.
+//!    of its ends over the cavity around it, else a Steiner point goes in near it, off it into
+//!    the region (Bowyer–Watson with the present boundary triangles as walls), and flips and
+//!    cones are tried again.
 //! 3. Triangle recovery: each boundary triangle that is not a face (its edges are) loses the
 //!    edges through it by flips, else the tetrahedra crossing it are replaced by a cone on
 //!    each side, from a vertex or from a Steiner point strictly inside that side (never on
@@ -45,6 +47,9 @@ use super::{ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
 use crate::geometry::DVec3;
 use crate::mesh::sorted_edge;
 
+/// Steiner points at most inserted near a missing edge.
+const STEINER_TRIES: usize = 3;
+
 /// Passes over the missing edges and triangles (a later pass sees the changes of the first).
 const PASSES: usize = 2;
 
@@ -74,6 +79,8 @@ pub struct RecoveryStats {
     pub flips: usize,
     pub edges_by_cavity: usize,
     pub triangles_by_cavity: usize,
+    /// Edges recovered after Steiner points were inserted near them.
+    pub edges_by_steiner: usize,
     /// Steiner points added (strictly off the boundary), and those inside the region.
     pub steiner_points: usize,
     pub steiner_points_inside: usize,
@@ -145,7 +152,21 @@ fn recover(recovery: &mut Recovery, boundary: &ClosedBoundary, stats: &mut Recov
             }
             if recovery.refill_edge(edge) {
                 stats.edges_by_cavity += 1;
-            } else {
+                continue;
+            }
+            let mut recovered = false;
+            for _ in 0..STEINER_TRIES {
+                if !recovery.steiner_near_edge(edge, &boundary.triangles) {
+                    break;
+                }
+                stats.steiner_points += 1;
+                recovered = recovery.flip_to(target, &mut stats.flips) || recovery.refill_edge(edge);
+                if recovered {
+                    stats.edges_by_steiner += 1;
+                    break;
+                }
+            }
+            if !recovered {
                 failed.push(target);
             }
         }
