@@ -849,7 +849,7 @@ impl TetMesh {
 
     /// The tetrahedron holding `p`, walking from `start` across the faces `p` lies beyond;
     /// `None` when the walk leaves the region or goes on too long.
-    pub(crate) fn locate(&self, start: u32, p: DVec3) -> Option<u32> {
+    fn locate(&self, start: u32, p: DVec3) -> Option<u32> {
         let mut t = start;
         'walk: for _ in 0..1000 {
             for face in self.outward_faces(t) {

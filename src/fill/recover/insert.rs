@@ -19,20 +19,38 @@ pub(super) enum Skipped {
     Duplicate,
 }
 
-/// The live tetrahedron whose closure holds `p`: by a walk from `hint`, else by a search.
+/// Steps at most of a walk before the search.
+const MAX_WALK: usize = 100_000;
+
+/// The live tetrahedron whose closure holds `p`: by a visibility walk from `hint` (leaving
+/// each tetrahedron through a face `p` is strictly beyond, the faces tried from one chosen by
+/// the step, so that it cannot cycle for long), else, when the walk leaves the region (a hole
+/// or a concave boundary is in the way), by a search of them all.
 fn locate(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
-    if mesh.is_alive(hint) {
-        if let Some(t) = mesh.locate(hint, p) {
-            return Some(t);
+    let beyond = |t: u32, i: usize| {
+        let f = inward_faces(mesh.tet(t))[i];
+        let [a, b, c] = f.map(|v| mesh.points[v as usize]);
+        orient3d(a, b, c, p) == Sign::Negative
+    };
+    let mut t = hint;
+    let mut came_from = NO_TET;
+    for step in 0..MAX_WALK.min(mesh.slots()) {
+        if !mesh.is_alive(t) {
+            break;
+        }
+        let first = ((step as u64 ^ u64::from(t)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 62) as usize;
+        let adjacent = mesh.adjacent(t);
+        let exit = (0..4).map(|j| (first + j) & 3).find(|&i| adjacent[i] != came_from && beyond(t, i));
+        match exit {
+            None => return Some(t),
+            Some(i) if adjacent[i] == NO_TET => break,
+            Some(i) => {
+                came_from = t;
+                t = adjacent[i];
+            }
         }
     }
-    (0..mesh.slots() as u32).filter(|&t| mesh.is_alive(t)).find(|&t| {
-        let tet = mesh.tet(t);
-        inward_faces(tet).iter().all(|f| {
-            let [a, b, c] = f.map(|v| mesh.points[v as usize]);
-            orient3d(a, b, c, p) != Sign::Negative
-        })
-    })
+    (0..mesh.slots() as u32).filter(|&t| mesh.is_alive(t)).find(|&t| (0..4).all(|i| !beyond(t, i)))
 }
 
 /// Insert `p` (strictly inside the region) near tetrahedron `hint`; the new point's index.

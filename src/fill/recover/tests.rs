@@ -173,11 +173,14 @@ proptest! {
 
     #[test]
     fn random_convex_hulls(coordinates in prop::collection::vec(-10i32..10, 3 * 8..3 * 40)) {
-        let points: Vec<DVec3> = coordinates.chunks_exact(3).map(|c| DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64) * 0.1).collect();
+        let points: Vec<DVec3> = coordinates.chunks_exact(3).map(|c| DVec3::new(c[0] as f64, c[1] as f64, c[2] as f64)).collect();
         let Some(mut s) = hull(&points) else { return Ok(()) };
         s.remove_unused_points();
         prop_assume!(s.triangles.len() >= 4);
-        fill_and_check(&region(&s, &[]), Vec::new());
+        let boundary = region(&s, &[]);
+        // The hull of points on a grid can have flat triangles (collinear points on a face).
+        prop_assume!(boundary.check_structure().is_ok());
+        fill_and_check(&boundary, Vec::new());
     }
 
     #[test]
