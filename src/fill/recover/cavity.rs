@@ -9,16 +9,20 @@
 //! - A missing edge `ab`: the cone from `a` over the faces of the cavity without `a` has the
 //!   edge (one of those faces has `b`); a face `a` does not see has the tetrahedron across it
 //!   taken into the cavity, and so on; then the same from `b`.
-//! - A missing triangle whose edges are edges: the tetrahedra crossing it meet its plane in
-//!   the triangle exactly (a tetrahedron crossing it cannot cross its edges), so the triangle
-//!   splits their cavity in two, each filled by a cone (from one of its vertices, else from a
-//!   Steiner point: the Schönhardt polyhedron needs one).
+//! - A missing triangle whose edges are edges, or the two triangles on a missing edge whose
+//!   other edges are edges (a patch): the tetrahedra crossing it meet its surface in the patch
+//!   exactly (a tetrahedron crossing it cannot cross its rim), so the patch splits their
+//!   cavity in two, each filled by a cone (from one of its vertices, else from a Steiner point:
+//!   the Schönhardt polyhedron needs one).
+
+use std::collections::{HashMap, HashSet};
 
 use super::cross::Target;
 use super::recovery::{inward_faces, Recovery};
 use crate::fill::improve::NO_TET;
 use crate::geometry::predicates::{orient2d, orient3d, Sign};
 use crate::geometry::DVec3;
+use crate::mesh::sorted_edge;
 
 /// Tetrahedra at most taken into a missing edge's cavity to make it seen from an end.
 const MAX_GROWTH: usize = 64;
@@ -103,49 +107,64 @@ impl Recovery {
         })
     }
 
-    /// Recover the missing triangle `abc` (whose edges are edges) by filling its cavity again;
-    /// returns the Steiner points added, `None` when no cone fills a side.
-    pub(super) fn refill_triangle(&mut self, abc: [u32; 3], triangles: &[[u32; 3]]) -> Option<usize> {
-        let cavity = self.crossing_tets(Target::Triangle(abc));
+    /// Recover the boundary triangles `patch` (a disc: one triangle, or two on a missing edge),
+    /// whose rim edges are edges, by filling their cavity again: the tetrahedra crossing them
+    /// (or the edges between them) meet the patch's surface in the patch exactly, so their
+    /// cavity's faces split at the rim into two discs, each closed by the patch into a side
+    /// filled by a cone. Returns the Steiner points added, `None` when no cone fills a side.
+    pub(super) fn refill_patch(&mut self, patch: &[[u32; 3]], triangles: &[[u32; 3]]) -> Option<usize> {
+        let edge_uses = directed_edges(patch);
+        let rim: Vec<[u32; 2]> = edge_uses
+            .iter()
+            .filter(|(e, _)| !edge_uses.contains_key(&[e[1], e[0]]))
+            .map(|(e, _)| *e)
+            .collect();
+        if rim.iter().any(|&[u, v]| !self.present(Target::Edge([u, v]))) {
+            return None;
+        }
+        let inner = edge_uses.keys().filter(|e| e[0] < e[1] && edge_uses.contains_key(&[e[1], e[0]]));
+        let targets = patch.iter().map(|&t| Target::Triangle(t)).chain(inner.map(|&e| Target::Edge(e)));
+        let mut cavity: Vec<u32> = targets.flat_map(|t| self.crossing_tets(t)).collect();
+        cavity.sort_unstable();
+        cavity.dedup();
         if cavity.is_empty() {
             return Some(0);
         }
-        let t = abc.map(|v| self.mesh.points[v as usize]);
-        let side = |f: &[u32; 3]| {
-            let signs = f.map(|v| orient3d(t[0], t[1], t[2], self.mesh.points[v as usize]));
-            signs.into_iter().find(|&s| s != Sign::Zero).unwrap_or(Sign::Zero)
-        };
         let faces: Vec<[u32; 3]> = self.cavity_faces(&cavity).into_iter().map(|(f, _)| f).collect();
-        let normal = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+        let sides = split_at_rim(&faces, &rim)?;
+        let x = |v: u32| self.mesh.points[v as usize];
         let mut cones = Vec::new();
-        for (sign, up, cap) in
-            [(Sign::Positive, normal, abc), (Sign::Negative, -normal, [abc[0], abc[2], abc[1]])]
-        {
-            let mut side_faces: Vec<[u32; 3]> = faces.iter().filter(|f| side(f) == sign).copied().collect();
-            side_faces.push(cap);
-            cones.push(self.cone(&side_faces, Some((t, up)), triangles)?);
+        for side in sides {
+            // The patch closes the side with its edges the other way round from the side's.
+            let along = side.iter().any(|f| (0..3).any(|i| edge_uses.contains_key(&[f[i], f[(i + 1) % 3]])));
+            let cap: Vec<[u32; 3]> =
+                patch.iter().map(|&[a, b, c]| if along { [a, c, b] } else { [a, b, c] }).collect();
+            let t = cap[0].map(x);
+            let up = (t[1] - t[0]).cross(t[2] - t[0]).normalize_or_zero();
+            let closed: Vec<[u32; 3]> = side.into_iter().chain(cap).collect();
+            cones.push(self.cone(&closed, Some((t, up)), triangles)?);
         }
-        let add: Vec<[u32; 4]> = cones.iter().flat_map(|c| c.tets.iter().copied()).collect();
-        // Steiner points are numbered in turn: the second cone's is one further.
-        if cones[0].steiner.is_some() && cones[1].steiner.is_some() {
-            let v = self.mesh.points.len() as u32;
-            let renumber = |t: [u32; 4]| t.map(|u| if u == v { v + 1 } else { u });
-            let (first, second) = (&cones[0], &cones[1]);
-            let second_tets: Vec<[u32; 4]> = second.tets.iter().map(|&t| renumber(t)).collect();
-            let all: Vec<[u32; 4]> = first.tets.iter().copied().chain(second_tets.iter().copied()).collect();
-            if !self.keeps_boundary(&cavity, &all) {
-                return None;
-            }
-            self.replace(cavity, first.tets.clone(), first.steiner);
-            self.replace(Vec::new(), second_tets, second.steiner);
-            return Some(2);
-        }
-        if !self.keeps_boundary(&cavity, &add) {
+        let [first, second] = &cones[..] else { return None };
+        // Steiner points are numbered in turn: the second cone's is one further when both have one.
+        let v = self.mesh.points.len() as u32;
+        let shift = u32::from(first.steiner.is_some() && second.steiner.is_some());
+        let second_tets: Vec<[u32; 4]> =
+            second.tets.iter().map(|t| t.map(|u| if u == v { v + shift } else { u })).collect();
+        let all: Vec<[u32; 4]> = first.tets.iter().copied().chain(second_tets.iter().copied()).collect();
+        if !self.keeps_boundary(&cavity, &all) {
             return None;
         }
-        let steiner = cones.iter().find_map(|c| c.steiner);
-        self.replace(cavity, add, steiner);
-        Some(usize::from(steiner.is_some()))
+        match (first.steiner, second.steiner) {
+            (Some(p), Some(q)) => {
+                self.replace(cavity, first.tets.clone(), Some(p));
+                self.replace(Vec::new(), second_tets, Some(q));
+                Some(2)
+            }
+            (p, q) => {
+                self.replace(cavity, all, p.or(q));
+                Some(usize::from(p.or(q).is_some()))
+            }
+        }
     }
 
     /// Recover the missing edge `ab` by a cone from one of its ends over a cavity around it
@@ -186,16 +205,23 @@ impl Recovery {
     /// Insert a Steiner point near the missing edge `ab`, off it into the region (along the
     /// sum of its boundary triangles' normals), by Bowyer–Watson with the present boundary
     /// triangles as walls, if one keeps the boundary; whether it did.
-    pub(super) fn steiner_near_edge(&mut self, [a, b]: [u32; 2], triangles: &[[u32; 3]]) -> bool {
+    pub(super) fn steiner_near_edge(
+        &mut self,
+        [a, b]: [u32; 2],
+        triangles: &[[u32; 3]],
+        attempt: usize,
+    ) -> bool {
         let x = |v: u32| self.mesh.points[v as usize];
         let normal = |t: &[u32; 3]| (x(t[1]) - x(t[0])).cross(x(t[2]) - x(t[0])).normalize_or_zero();
         let at_edge = triangles.iter().filter(|t| t.contains(&a) && t.contains(&b));
         let direction = at_edge.map(normal).sum::<DVec3>().normalize_or_zero();
-        let (middle, length) = (0.5 * (x(a) + x(b)), x(a).distance(x(b)));
+        let length = x(a).distance(x(b));
         let hint = self.mesh.ball(a).first().copied().unwrap_or(0);
         let wall = |f: &[u32; 3]| self.triangles.contains(&crate::fill::sorted_triangle(*f));
+        // Along the edge: its middle first, then a point further on at each attempt.
+        let along = STEINER_ALONG[attempt % STEINER_ALONG.len()];
         for s in [0.2, 0.05, 0.01] {
-            let p = middle + s * length * direction;
+            let p = x(a).lerp(x(b), along) + s * length * direction;
             if triangles.iter().any(|t| on_triangle(p, t.map(x))) {
                 continue;
             }
@@ -207,6 +233,62 @@ impl Recovery {
         }
         false
     }
+}
+
+/// Where along a missing edge the Steiner points near it go, in turn.
+const STEINER_ALONG: [f64; 7] = [0.5, 0.25, 0.75, 0.125, 0.875, 0.375, 0.625];
+
+/// The directed edges of some triangles, with the triangle using each.
+fn directed_edges(triangles: &[[u32; 3]]) -> HashMap<[u32; 2], usize> {
+    let mut edges = HashMap::new();
+    for (k, t) in triangles.iter().enumerate() {
+        for i in 0..3 {
+            edges.insert([t[i], t[(i + 1) % 3]], k);
+        }
+    }
+    edges
+}
+
+/// The cavity's faces in the two parts the rim edges split them into (through the other
+/// edges, each shared by two faces); `None` unless there are two.
+fn split_at_rim(faces: &[[u32; 3]], rim: &[[u32; 2]]) -> Option<[Vec<[u32; 3]>; 2]> {
+    let rim: HashSet<[u32; 2]> = rim.iter().map(|&[u, v]| sorted_edge(u, v)).collect();
+    let mut at_edge: HashMap<[u32; 2], Vec<usize>> = HashMap::new();
+    for (k, f) in faces.iter().enumerate() {
+        for i in 0..3 {
+            at_edge.entry(sorted_edge(f[i], f[(i + 1) % 3])).or_default().push(k);
+        }
+    }
+    let mut part = vec![usize::MAX; faces.len()];
+    let mut parts = 0;
+    for seed in 0..faces.len() {
+        if part[seed] != usize::MAX {
+            continue;
+        }
+        let mut stack = vec![seed];
+        part[seed] = parts;
+        while let Some(k) = stack.pop() {
+            let f = faces[k];
+            for i in 0..3 {
+                let e = sorted_edge(f[i], f[(i + 1) % 3]);
+                if rim.contains(&e) {
+                    continue;
+                }
+                for &n in &at_edge[&e] {
+                    if part[n] == usize::MAX {
+                        part[n] = parts;
+                        stack.push(n);
+                    }
+                }
+            }
+        }
+        parts += 1;
+    }
+    if parts != 2 {
+        return None;
+    }
+    let side = |s: usize| faces.iter().zip(&part).filter(|(_, &p)| p == s).map(|(f, _)| *f).collect();
+    Some([side(0), side(1)])
 }
 
 /// Whether `p` is on the closed triangle `t` (exact).

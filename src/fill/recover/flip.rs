@@ -1,6 +1,7 @@
 //! Recovery by flips: a missing boundary edge or triangle is crossed by fewer and fewer edges
 //! and faces, each step the flip (2-3 on a face, or the removal of an edge: 3-2, 4-4 and
-//! larger rings) that takes away the most crossings, until none is left or no flip helps.
+//! larger rings) that takes away the most crossings, or where none does, two flips in a row
+//! that do (the first may add one), until none is left or nothing helps.
 
 use super::cross::Target;
 use super::recovery::{inward_faces, tet_edges, Recovery};
@@ -22,23 +23,60 @@ struct Flip {
 }
 
 impl Recovery {
-    /// Flip until the target is an edge or a face (`true`) or no flip takes a crossing away;
-    /// counts the flips made in `flips`.
+    /// Flip until the target is an edge or a face (`true`) or no flip, nor two in a row, takes
+    /// a crossing away; counts the flips made in `flips`.
     pub(super) fn flip_to(&mut self, target: Target, flips: &mut usize) -> bool {
         for _ in 0..MAX_FLIPS {
             let crossing = self.crossing_tets(target);
             if crossing.is_empty() {
                 return self.present(target);
             }
-            let Some(best) = self.best_flip(target, &crossing) else { return false };
-            *flips += 1;
-            self.replace(best.remove, best.add, None);
+            let candidates = self.flips(target, &crossing);
+            let count = candidates.len();
+            match candidates.into_iter().max_by_key(|f| f.gain) {
+                Some(best) if best.gain > 0 => {
+                    *flips += 1;
+                    self.replace(best.remove, best.add, None);
+                }
+                _ if self.two_flips(target, count, flips) => {}
+                _ => return false,
+            }
         }
         false
     }
 
-    /// The flip at the tetrahedra `crossing` that takes away the most crossings, if one does.
-    fn best_flip(&self, target: Target, crossing: &[u32]) -> Option<Flip> {
+    /// Where no flip takes a crossing away: a flip that takes none followed by one that takes
+    /// some, if there is such a pair; whether it made one. (Each first flip tried is undone,
+    /// which renumbers tetrahedra: the candidates are listed again after it.)
+    fn two_flips(&mut self, target: Target, count: usize, flips: &mut usize) -> bool {
+        for k in 0..count {
+            let crossing = self.crossing_tets(target);
+            let Some(first) = self.flips(target, &crossing).into_iter().filter(|f| f.gain >= 0).nth(k) else {
+                return false;
+            };
+            let undo: Vec<[u32; 4]> = first.remove.iter().map(|&t| self.mesh.tet(t)).collect();
+            let slots = self.mesh.slots() as u32;
+            self.replace(first.remove, first.add, None);
+            let created: Vec<u32> = (slots..self.mesh.slots() as u32).collect();
+            let crossing = self.crossing_tets(target);
+            let second = self
+                .flips(target, &crossing)
+                .into_iter()
+                .filter(|f| first.gain + f.gain > 0)
+                .max_by_key(|f| f.gain);
+            if let Some(second) = second {
+                *flips += 2;
+                self.replace(second.remove, second.add, None);
+                return true;
+            }
+            self.replace(created, undo, None);
+        }
+        false
+    }
+
+    /// The flips at the tetrahedra `crossing` that keep the boundary, with how many crossings
+    /// each takes away.
+    fn flips(&self, target: Target, crossing: &[u32]) -> Vec<Flip> {
         let mut faces: Vec<[u32; 3]> =
             crossing.iter().flat_map(|&t| inward_faces(self.mesh.tet(t))).map(sorted_triangle).collect();
         faces.sort_unstable();
@@ -61,8 +99,7 @@ impl Recovery {
                 let gain = -self.crossing_change(target, &remove, &add);
                 Flip { remove, add, gain }
             })
-            .filter(|f| f.gain > 0)
-            .max_by_key(|f| f.gain)
+            .collect()
     }
 
     /// The removal of edge `ab` whose new edges and faces cross the target least, with every

@@ -48,7 +48,7 @@ use crate::geometry::DVec3;
 use crate::mesh::sorted_edge;
 
 /// Steiner points at most inserted near a missing edge.
-const STEINER_TRIES: usize = 3;
+const STEINER_TRIES: usize = 7;
 
 /// Passes over the missing edges and triangles (a later pass sees the changes of the first).
 const PASSES: usize = 2;
@@ -87,7 +87,9 @@ pub struct RecoveryStats {
 }
 
 /// The tetrahedralisation of the region bounded by `boundary` keeping every triangle, its
-/// boundary points first (then its Steiner points, and points no tetrahedron uses).
+/// boundary points first (then its Steiner points, and points no tetrahedron uses). With the
+/// environment variable `BLMESH_DUMP_RECOVERY=FILE`, a boundary it cannot recover is written
+/// to FILE as JSON (points, triangles) for the ignored test `dumped_boundary`.
 pub fn recover_region(boundary: &ClosedBoundary) -> Result<(TetMesh, RecoveryStats), FillError> {
     let start = Instant::now();
     boundary.check_no_self_intersection()?;
@@ -102,6 +104,10 @@ pub fn recover_region(boundary: &ClosedBoundary) -> Result<(TetMesh, RecoverySta
     let mut stats = RecoveryStats::default();
     let failed = recover(&mut recovery, boundary, &mut stats);
     if !failed.is_empty() {
+        if let Ok(path) = std::env::var("BLMESH_DUMP_RECOVERY") {
+            let json = serde_json::json!({"points": boundary.points, "triangles": boundary.triangles});
+            let _ = std::fs::write(path, json.to_string());
+        }
         let examples: Vec<String> =
             failed.iter().take(5).map(|t| describe(t, &recovery.mesh.points)).collect();
         return Err(FillError::Recovery(format!(
@@ -154,19 +160,35 @@ fn recover(recovery: &mut Recovery, boundary: &ClosedBoundary, stats: &mut Recov
                 stats.edges_by_cavity += 1;
                 continue;
             }
+            let [a, b] = edge;
+            let patch: Vec<[u32; 3]> =
+                boundary.triangles.iter().filter(|t| t.contains(&a) && t.contains(&b)).copied().collect();
+            if let Some(added) = recovery.refill_patch(&patch, &boundary.triangles) {
+                stats.edges_by_cavity += 1;
+                stats.steiner_points += added;
+                continue;
+            }
             let mut recovered = false;
-            for _ in 0..STEINER_TRIES {
-                if !recovery.steiner_near_edge(edge, &boundary.triangles) {
-                    break;
+            for attempt in 0..STEINER_TRIES {
+                // A Steiner point that does not help is taken out again (with the flips after it).
+                let saved = recovery.mesh.clone();
+                if !recovery.steiner_near_edge(edge, &boundary.triangles, attempt) {
+                    continue;
                 }
-                stats.steiner_points += 1;
                 recovered = recovery.flip_to(target, &mut stats.flips) || recovery.refill_edge(edge);
                 if recovered {
+                    stats.steiner_points += 1;
                     stats.edges_by_steiner += 1;
                     break;
                 }
+                recovery.mesh = saved;
             }
             if !recovered {
+                tracing::debug!(
+                    edge = describe(&target, &recovery.mesh.points),
+                    crossings = recovery.crossing_tets(target).len(),
+                    "edge not recovered"
+                );
                 failed.push(target);
             }
         }
@@ -187,7 +209,7 @@ fn recover(recovery: &mut Recovery, boundary: &ClosedBoundary, stats: &mut Recov
             if recovery.flip_to(target, &mut stats.flips) {
                 continue;
             }
-            match recovery.refill_triangle(triangle, &boundary.triangles) {
+            match recovery.refill_patch(&[triangle], &boundary.triangles) {
                 Some(added) => {
                     stats.triangles_by_cavity += 1;
                     stats.steiner_points += added;

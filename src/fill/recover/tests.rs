@@ -205,3 +205,16 @@ proptest! {
         fill_and_check(&region(&shapes::cuboid(DVec3::splat(6.0), 2 * n), &holes), Vec::new());
     }
 }
+
+/// A boundary the pipeline failed to recover, written by `BLMESH_DUMP_RECOVERY=FILE` (see
+/// [`recover_region`]): `BLMESH_RECOVERY_CASE=FILE cargo test dumped_boundary -- --ignored`.
+#[test]
+#[ignore]
+fn dumped_boundary() {
+    let path = std::env::var("BLMESH_RECOVERY_CASE").expect("BLMESH_RECOVERY_CASE names the dumped boundary");
+    let json: serde_json::Value = serde_json::from_str(&std::fs::read_to_string(path).unwrap()).unwrap();
+    let points: Vec<DVec3> = serde_json::from_value(json["points"].clone()).unwrap();
+    let triangles: Vec<[u32; 3]> = serde_json::from_value(json["triangles"].clone()).unwrap();
+    let boundary = ClosedBoundary { markers: vec![MARKER_WALL; triangles.len()], points, triangles };
+    eprintln!("{:?}", fill_and_check(&boundary, Vec::new()));
+}
