@@ -225,7 +225,9 @@ impl Recovery {
             if triangles.iter().any(|t| on_triangle(p, t.map(x))) {
                 continue;
             }
-            let Ok((remove, add)) = super::insert::star_cavity(&self.mesh, hint, p, &wall) else { continue };
+            let Ok((remove, add)) = super::insert::star_cavity(&self.mesh, &[hint], p, &wall) else {
+                continue;
+            };
             if self.keeps_boundary(&remove, &add) {
                 self.replace(remove, add, Some(p));
                 return true;

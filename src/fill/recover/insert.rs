@@ -22,11 +22,24 @@ pub(super) enum Skipped {
 /// Steps at most of a walk before the search.
 const MAX_WALK: usize = 100_000;
 
-/// The live tetrahedron whose closure holds `p`: by a visibility walk from `hint` (leaving
-/// each tetrahedron through a face `p` is strictly beyond, the faces tried from one chosen by
-/// the step, so that it cannot cycle for long), else, when the walk leaves the region (a hole
-/// or a concave boundary is in the way), by a search of them all.
-fn locate(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
+/// The live tetrahedron whose closure holds `p`: by a visibility walk from each of `hints` in
+/// turn (leaving each tetrahedron through a face `p` is strictly beyond, the faces tried from
+/// one chosen by the step, so that it cannot cycle for long), else, when every walk leaves the
+/// region (a hole or a concave boundary is in the way), by a search of them all.
+fn locate(mesh: &TetMesh, hints: &[u32], p: DVec3) -> Option<u32> {
+    let beyond = |t: u32, i: usize| {
+        let f = inward_faces(mesh.tet(t))[i];
+        let [a, b, c] = f.map(|v| mesh.points[v as usize]);
+        orient3d(a, b, c, p) == Sign::Negative
+    };
+    if let Some(t) = hints.iter().find_map(|&hint| walk(mesh, hint, p)) {
+        return Some(t);
+    }
+    (0..mesh.slots() as u32).filter(|&t| mesh.is_alive(t)).find(|&t| (0..4).all(|i| !beyond(t, i)))
+}
+
+/// The visibility walk of [`locate`] from `hint`; `None` when it leaves the region.
+fn walk(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
     let beyond = |t: u32, i: usize| {
         let f = inward_faces(mesh.tet(t))[i];
         let [a, b, c] = f.map(|v| mesh.points[v as usize]);
@@ -50,27 +63,28 @@ fn locate(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
             }
         }
     }
-    (0..mesh.slots() as u32).filter(|&t| mesh.is_alive(t)).find(|&t| (0..4).all(|i| !beyond(t, i)))
+    None
 }
 
-/// Insert `p` (strictly inside the region) near tetrahedron `hint`; the new point's index.
-pub(super) fn insert_point(mesh: &mut TetMesh, hint: u32, p: DVec3) -> Result<u32, Skipped> {
-    let (remove, add) = star_cavity(mesh, hint, p, &|_| false)?;
+/// Insert `p` (strictly inside the region), locating it from the tetrahedra `hints`; the new
+/// point's index.
+pub(super) fn insert_point(mesh: &mut TetMesh, hints: &[u32], p: DVec3) -> Result<u32, Skipped> {
+    let (remove, add) = star_cavity(mesh, hints, p, &|_| false)?;
     let v = mesh.points.len() as u32;
     mesh.apply(&Change::replacing(remove, add, Some((v, p))));
     Ok(v)
 }
 
-/// The tetrahedra to replace to insert `p` near tetrahedron `hint`, and the cone from the new
+/// The tetrahedra to replace to insert `p` (located from `hints`), and the cone from the new
 /// point (the next point index) replacing them; the cavity does not cross the faces without
 /// a tetrahedron across nor the `wall` faces, and `p` must be strictly off them.
 pub(super) fn star_cavity(
     mesh: &TetMesh,
-    hint: u32,
+    hints: &[u32],
     p: DVec3,
     wall: &dyn Fn(&[u32; 3]) -> bool,
 ) -> Result<(Vec<u32>, Vec<[u32; 4]>), Skipped> {
-    let start = locate(mesh, hint, p).ok_or(Skipped::Outside)?;
+    let start = locate(mesh, hints, p).ok_or(Skipped::Outside)?;
     let tet = mesh.tet(start);
     if tet.iter().any(|&v| mesh.points[v as usize] == p) {
         return Err(Skipped::Duplicate);

@@ -60,7 +60,7 @@ pub struct NativeCore;
 impl CoreMesher for NativeCore {
     fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError> {
         let (mut mesh, stats) = recover_region(boundary)?;
-        let inserted = insert_guide(&mut mesh, &guide.interior);
+        let inserted = insert_guide(&mut mesh, &boundary.triangles, &guide.interior);
         tracing::info!(?stats, inserted, of = guide.interior.len(), "native core: boundary recovered");
         let (points, tets) = mesh.into_parts();
         let mut core = CoreTets { points, tets, boundary_steiner_points: 0 };
@@ -93,6 +93,7 @@ pub struct RecoveryStats {
 pub fn recover_region(boundary: &ClosedBoundary) -> Result<(TetMesh, RecoveryStats), FillError> {
     let start = Instant::now();
     boundary.check_no_self_intersection()?;
+    let checked = start.elapsed().as_secs_f64();
     let n = boundary.points.len();
     let mut points = boundary.points.clone();
     points.extend(box_corners(&boundary.points));
@@ -100,9 +101,12 @@ pub fn recover_region(boundary: &ClosedBoundary) -> Result<(TetMesh, RecoverySta
     if let Some(d) = delaunay.duplicates().first() {
         return Err(FillError::Input(format!("boundary points {} and {} coincide", d.point, d.of)));
     }
+    let triangulated = start.elapsed().as_secs_f64();
     let mut recovery = Recovery::new(delaunay.to_tet_mesh(n), &boundary.triangles);
+    let linked = start.elapsed().as_secs_f64();
     let mut stats = RecoveryStats::default();
     let failed = recover(&mut recovery, boundary, &mut stats);
+    let recovered = start.elapsed().as_secs_f64();
     if !failed.is_empty() {
         if let Ok(path) = std::env::var("BLMESH_DUMP_RECOVERY") {
             let json = serde_json::json!({"points": boundary.points, "triangles": boundary.triangles});
@@ -134,7 +138,15 @@ pub fn recover_region(boundary: &ClosedBoundary) -> Result<(TetMesh, RecoverySta
     }
     stats.steiner_points = mesh.points.len() - steiner;
     stats.steiner_points_inside = used[steiner..].iter().filter(|&&u| u).count();
-    tracing::debug!(?stats, seconds = start.elapsed().as_secs_f64(), "boundary recovery");
+    tracing::debug!(
+        ?stats,
+        checked,
+        triangulated,
+        linked,
+        recovered,
+        seconds = start.elapsed().as_secs_f64(),
+        "boundary recovery (seconds from its start)"
+    );
     Ok((TetMesh::new(mesh.points, tets, n), stats))
 }
 
@@ -249,12 +261,22 @@ fn box_corners(points: &[DVec3]) -> [DVec3; 8] {
     })
 }
 
-/// Insert the points `interior` inside the region, in order; returns how many went in.
-fn insert_guide(mesh: &mut TetMesh, interior: &[DVec3]) -> usize {
+/// Insert the points `interior` inside the region bounded by `triangles`, in order; returns
+/// how many went in. Each is located from the last tetrahedron made, else from the one on the
+/// boundary triangle nearest to it.
+fn insert_guide(mesh: &mut TetMesh, triangles: &[[u32; 3]], interior: &[DVec3]) -> usize {
+    if interior.is_empty() {
+        return 0;
+    }
+    let corners = triangles.iter().map(|t| t.map(|v| mesh.points[v as usize])).collect();
+    let bvh = crate::geometry::bvh::TriangleBvh::new(corners);
     let mut inserted = 0;
     for &p in interior {
-        let hint = mesh.slots().saturating_sub(1) as u32;
-        if insert::insert_point(mesh, hint, p).is_ok() {
+        let last = mesh.slots().saturating_sub(1) as u32;
+        let near =
+            bvh.nearest(p).and_then(|n| mesh.tets_with(&triangles[n.triangle as usize]).first().copied());
+        let hints: Vec<u32> = std::iter::once(last).chain(near).collect();
+        if insert::insert_point(mesh, &hints, p).is_ok() {
             inserted += 1;
         }
     }

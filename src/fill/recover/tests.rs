@@ -216,5 +216,8 @@ fn dumped_boundary() {
     let points: Vec<DVec3> = serde_json::from_value(json["points"].clone()).unwrap();
     let triangles: Vec<[u32; 3]> = serde_json::from_value(json["triangles"].clone()).unwrap();
     let boundary = ClosedBoundary { markers: vec![MARKER_WALL; triangles.len()], points, triangles };
+    let start = std::time::Instant::now();
+    let stats = recover_region(&boundary).map(|(_, stats)| stats);
+    eprintln!("{stats:?} in {:.2} s", start.elapsed().as_secs_f64());
     eprintln!("{:?}", fill_and_check(&boundary, Vec::new()));
 }
