@@ -487,7 +487,11 @@ impl TetMesh {
     /// Commit a change proposed by one of the operators.
     pub fn apply(&mut self, change: &Change) {
         self.applied += 1;
-        let moved_ball = change.point.filter(|_| change.remove.is_empty()).map(|(v, _)| v);
+        // A point moved (not added: a change may fill an empty cavity around a new point).
+        let moved_ball = change
+            .point
+            .filter(|&(v, _)| change.remove.is_empty() && (v as usize) < self.points.len())
+            .map(|(v, _)| v);
         let touched = change
             .remove
             .iter()
