@@ -92,7 +92,11 @@ impl Recovery {
         }
         let x = |v: u32| self.mesh.points[v as usize];
         let centroid = vertices.iter().map(|&v| x(v)).sum::<DVec3>() / vertices.len() as f64;
-        let mut candidates = vec![centroid];
+        let mut candidates: Vec<DVec3> =
+            kernel_point(&faces.iter().map(|f| f.map(x)).collect::<Vec<_>>(), centroid)
+                .into_iter()
+                .chain([centroid])
+                .collect();
         if let Some((t, up)) = over {
             let middle = (t[0] + t[1] + t[2]) / 3.0;
             let height = vertices.iter().map(|&v| (x(v) - middle).dot(up)).fold(0.0, f64::max);
@@ -239,6 +243,36 @@ impl Recovery {
 
 /// Where along a missing edge the Steiner points near it go, in turn.
 const STEINER_ALONG: [f64; 7] = [0.5, 0.25, 0.75, 0.125, 0.875, 0.375, 0.625];
+
+/// Steps of the search for [`kernel_point`].
+const KERNEL_STEPS: usize = 400;
+
+/// A point deep inside the kernel of the region bounded by `faces` (normals inward): the
+/// largest smallest distance to the faces' planes, by subgradient ascent from `start`
+/// (floating point: only a candidate, tested exactly by the caller); `None` when no point is
+/// inside them all.
+fn kernel_point(faces: &[[DVec3; 3]], start: DVec3) -> Option<DVec3> {
+    let planes: Vec<(DVec3, DVec3)> = faces
+        .iter()
+        .filter_map(|[a, b, c]| {
+            let n = (*b - *a).cross(*c - *a).normalize_or_zero();
+            (n != DVec3::ZERO).then_some((*a, n))
+        })
+        .collect();
+    let scale = faces.iter().flatten().map(|p| p.distance(start)).fold(0.0, f64::max);
+    let depth =
+        |p: DVec3| planes.iter().map(|&(a, n)| ((p - a).dot(n), n)).min_by(|x, y| x.0.total_cmp(&y.0));
+    let (mut best, mut best_depth) = (start, depth(start)?.0);
+    let mut p = start;
+    for k in 0..KERNEL_STEPS {
+        let (d, n) = depth(p)?;
+        if d > best_depth {
+            (best, best_depth) = (p, d);
+        }
+        p += n * (scale * 0.1 / (1.0 + k as f64).sqrt());
+    }
+    (best_depth > 0.0).then_some(best)
+}
 
 /// The directed edges of some triangles, with the triangle using each.
 fn directed_edges(triangles: &[[u32; 3]]) -> HashMap<[u32; 2], usize> {
