@@ -32,11 +32,11 @@ fn tet_faces(tet: [u32; 4]) -> [[u32; 3]; 4] {
     inward_faces(tet).map(sorted_triangle)
 }
 
-/// The edges and faces of some tetrahedra, each once.
+/// The edges and faces of some tetrahedra, each once, sorted.
 #[derive(Default)]
 struct Elements {
-    edges: HashSet<[u32; 2]>,
-    faces: HashSet<[u32; 3]>,
+    edges: Vec<[u32; 2]>,
+    faces: Vec<[u32; 3]>,
 }
 
 impl Elements {
@@ -46,7 +46,19 @@ impl Elements {
             elements.edges.extend(tet_edges(tet));
             elements.faces.extend(tet_faces(tet));
         }
+        elements.edges.sort_unstable();
+        elements.edges.dedup();
+        elements.faces.sort_unstable();
+        elements.faces.dedup();
         elements
+    }
+
+    fn has_edge(&self, e: &[u32; 2]) -> bool {
+        self.edges.binary_search(e).is_ok()
+    }
+
+    fn has_face(&self, f: &[u32; 3]) -> bool {
+        self.faces.binary_search(f).is_ok()
     }
 }
 
@@ -86,8 +98,8 @@ impl Recovery {
         let old = Elements::of(remove.iter().map(|&t| self.mesh.tet(t)));
         let new = Elements::of(add.iter().copied());
         let points: HashSet<u32> = add.iter().flatten().copied().collect();
-        old.edges.iter().all(|e| !self.edges.contains(e) || new.edges.contains(e))
-            && old.faces.iter().all(|f| !self.triangles.contains(f) || new.faces.contains(f))
+        old.edges.iter().all(|e| !self.edges.contains(e) || new.has_edge(e))
+            && old.faces.iter().all(|f| !self.triangles.contains(f) || new.has_face(f))
             && remove.iter().flat_map(|&t| self.mesh.tet(t)).all(|v| points.contains(&v))
     }
 
@@ -98,8 +110,7 @@ impl Recovery {
         let mut seen: HashMap<u32, bool> = HashMap::new();
         let mut queue: VecDeque<u32> = VecDeque::new();
         let mut crossing = Vec::new();
-        let start: Vec<u32> = target.vertices().iter().flat_map(|&v| self.mesh.ball(v).to_vec()).collect();
-        queue.extend(start);
+        queue.extend(target.vertices().iter().flat_map(|&v| self.mesh.ball(v).iter().copied()));
         while let Some(t) = queue.pop_front() {
             if seen.contains_key(&t) {
                 continue;
@@ -140,8 +151,8 @@ impl Recovery {
 
 /// The elements of `x` not in `y`.
 fn only<'a>(x: &'a Elements, y: &'a Elements) -> impl Iterator<Item = Element<'a>> {
-    let edges = x.edges.iter().filter(|e| !y.edges.contains(*e)).map(Element::Edge);
-    let faces = x.faces.iter().filter(|f| !y.faces.contains(*f)).map(Element::Face);
+    let edges = x.edges.iter().filter(|e| !y.has_edge(e)).map(Element::Edge);
+    let faces = x.faces.iter().filter(|f| !y.has_face(f)).map(Element::Face);
     edges.chain(faces)
 }
 
