@@ -25,8 +25,17 @@ impl Target {
         }
     }
 
+    /// Whether an element with `nodes` shares one with the target: then it does not cross it
+    /// (an edge or face through a target's node meets it there only, or in its plane).
+    fn touches(&self, nodes: &[u32]) -> bool {
+        nodes.iter().any(|v| self.vertices().contains(v))
+    }
+
     /// Whether edge `xy` crosses the target.
     pub(super) fn crossed_by_edge(&self, points: &[DVec3], [x, y]: [u32; 2]) -> bool {
+        if self.touches(&[x, y]) {
+            return false;
+        }
         let p = |v: u32| points[v as usize];
         match *self {
             Target::Edge([a, b]) => segments_cross(p(a), p(b), p(x), p(y)),
@@ -36,6 +45,9 @@ impl Target {
 
     /// Whether the interior of face `xyz` is crossed by the target (an edge's only).
     pub(super) fn crossed_by_face(&self, points: &[DVec3], face: [u32; 3]) -> bool {
+        if self.touches(&face) {
+            return false;
+        }
         match *self {
             Target::Edge([a, b]) => {
                 let p = |v: u32| points[v as usize];
