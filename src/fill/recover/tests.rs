@@ -66,6 +66,7 @@ fn check(boundary: &ClosedBoundary, core: &CoreTets) {
 /// figures.
 fn fill_and_check(boundary: &ClosedBoundary, interior: Vec<DVec3>) -> RecoveryStats {
     let (_, stats) = recover_region(boundary).unwrap();
+    eprintln!("{} triangles: {stats:?}", boundary.triangles.len());
     let guide = CoreGuide { interior, ..Default::default() };
     let core = NativeCore.fill(boundary, &guide).unwrap();
     check(boundary, &core);
