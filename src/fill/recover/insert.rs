@@ -13,8 +13,12 @@ use crate::geometry::DVec3;
 /// Why a point was not inserted.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub(super) enum Skipped {
-    /// Outside the region or on its boundary.
+    /// Outside the region (in no tetrahedron).
     Outside,
+    /// On a boundary triangle (or a wall).
+    OnBoundary,
+    /// No cavity around it is star-shaped from it.
+    NoStar,
     /// At a vertex.
     Duplicate,
 }
@@ -46,19 +50,20 @@ fn walk(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
         orient3d(a, b, c, p) == Sign::Negative
     };
     let mut t = hint;
-    let mut came_from = NO_TET;
+    // No tetrahedron is `NO_TET` (a face without one across is an exit like any other).
+    let mut came_from = None;
     for step in 0..MAX_WALK.min(mesh.slots()) {
         if !mesh.is_alive(t) {
             break;
         }
         let first = ((step as u64 ^ u64::from(t)).wrapping_mul(0x9E37_79B9_7F4A_7C15) >> 62) as usize;
         let adjacent = mesh.adjacent(t);
-        let exit = (0..4).map(|j| (first + j) & 3).find(|&i| adjacent[i] != came_from && beyond(t, i));
+        let exit = (0..4).map(|j| (first + j) & 3).find(|&i| Some(adjacent[i]) != came_from && beyond(t, i));
         match exit {
             None => return Some(t),
             Some(i) if adjacent[i] == NO_TET => break,
             Some(i) => {
-                came_from = t;
+                came_from = Some(t);
                 t = adjacent[i];
             }
         }
@@ -94,7 +99,7 @@ pub(super) fn star_cavity(
     for (i, f) in inward_faces(tet).iter().enumerate() {
         let closed = mesh.adjacent(start)[i] == NO_TET || wall(f);
         if closed && orient3d(x(f[0]), x(f[1]), x(f[2]), p) == Sign::Zero {
-            return Err(Skipped::Outside);
+            return Err(Skipped::OnBoundary);
         }
     }
     let mut cavity: BTreeSet<u32> = BTreeSet::from([start]);
@@ -119,7 +124,7 @@ pub(super) fn star_cavity(
         let seen = |f: &[u32; 3]| orient3d(x(f[0]), x(f[1]), x(f[2]), p) == Sign::Positive;
         match faces.iter().find(|(f, _)| !seen(f)) {
             // Only on a face of the first tetrahedron: `p` is on the boundary.
-            Some(&(_, t)) if t == start => return Err(Skipped::Outside),
+            Some(&(_, t)) if t == start => return Err(Skipped::OnBoundary),
             Some(&(_, t)) => {
                 cavity.remove(&t);
                 keep_connected(mesh, &mut cavity, start);
@@ -134,7 +139,7 @@ pub(super) fn star_cavity(
         if let Some(u) = lost {
             // A vertex inside the cavity: a tetrahedron at it leaves.
             let Some(&t) = cavity.iter().find(|&&t| t != start && mesh.tet(t).contains(&u)) else {
-                return Err(Skipped::Outside);
+                return Err(Skipped::NoStar);
             };
             cavity.remove(&t);
             keep_connected(mesh, &mut cavity, start);

@@ -60,8 +60,8 @@ pub struct NativeCore;
 impl CoreMesher for NativeCore {
     fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError> {
         let (mut mesh, stats) = recover_region(boundary)?;
-        let inserted = insert_guide(&mut mesh, &boundary.triangles, &guide.interior);
-        tracing::info!(?stats, inserted, of = guide.interior.len(), "native core: boundary recovered");
+        let skipped = insert_guide(&mut mesh, &boundary.triangles, &guide.interior);
+        tracing::info!(?stats, ?skipped, of = guide.interior.len(), "native core: boundary recovered");
         let (points, tets) = mesh.into_parts();
         let mut core = CoreTets { points, tets, boundary_steiner_points: 0 };
         super::merge::drop_unused_points(&mut core, boundary.points.len());
@@ -262,23 +262,23 @@ fn box_corners(points: &[DVec3]) -> [DVec3; 8] {
 }
 
 /// Insert the points `interior` inside the region bounded by `triangles`, in order; returns
-/// how many went in. Each is located from the last tetrahedron made, else from the one on the
+/// why those left out were. Each is located from the last tetrahedron made, else from the one on the
 /// boundary triangle nearest to it.
-fn insert_guide(mesh: &mut TetMesh, triangles: &[[u32; 3]], interior: &[DVec3]) -> usize {
+fn insert_guide(mesh: &mut TetMesh, triangles: &[[u32; 3]], interior: &[DVec3]) -> Vec<insert::Skipped> {
+    let mut skipped = Vec::new();
     if interior.is_empty() {
-        return 0;
+        return skipped;
     }
     let corners = triangles.iter().map(|t| t.map(|v| mesh.points[v as usize])).collect();
     let bvh = crate::geometry::bvh::TriangleBvh::new(corners);
-    let mut inserted = 0;
     for &p in interior {
         let last = mesh.slots().saturating_sub(1) as u32;
         let near =
             bvh.nearest(p).and_then(|n| mesh.tets_with(&triangles[n.triangle as usize]).first().copied());
         let hints: Vec<u32> = std::iter::once(last).chain(near).collect();
-        if insert::insert_point(mesh, &hints, p).is_ok() {
-            inserted += 1;
+        if let Err(why) = insert::insert_point(mesh, &hints, p) {
+            skipped.push(why);
         }
     }
-    inserted
+    skipped
 }
