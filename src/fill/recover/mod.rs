@@ -7,7 +7,7 @@
 //!    around them, a box-diagonal away: the boundary lies strictly inside the hull, so every
 //!    edge and face it needs is inside, where flips have tetrahedra on both sides (a farfield
 //!    box's coplanar faces are flipped like any other).
-//! 2. Edge recovery ([`flip`], then [`cavity`]): each boundary edge that is not an edge is
+//! 2. Edge recovery (`flip`, then `cavity`): each boundary edge that is not an edge is
 //!    crossed by fewer and fewer faces and edges by flips (or two in a row where one does not
 //!    help), else it is made by a cone from one of its ends over the cavity around it, else
 //!    the cavity of its two boundary triangles (when their other edges are there) is filled
@@ -18,11 +18,11 @@
 //!    edges through it by flips, else the tetrahedra crossing it are replaced by a cone on
 //!    each side, from a vertex or from a Steiner point strictly inside that side (never on
 //!    the boundary: tested exactly against every boundary triangle).
-//! 4. Exterior removal ([`exterior`]): the tetrahedra on the region's side of the boundary
+//! 4. Exterior removal (`exterior`): the tetrahedra on the region's side of the boundary
 //!    triangles (their right-hand normals point into the region, as [`ClosedBoundary`] says),
 //!    flooded across the other faces; the box's corners go with the outside.
 //! 5. The guide's interior points inside the region, inserted by Bowyer–Watson with the
-//!    boundary as walls ([`insert`]); points outside, on the boundary or at a vertex are left
+//!    boundary as walls (`insert`); points outside, on the boundary or at a vertex are left
 //!    out.
 //!
 //! Present boundary edges and triangles are never taken away by a later step (the flips and
