@@ -39,6 +39,9 @@ pub struct Settings {
     /// Largest angle (degrees) between neighbouring normals of a fan at a convex ridge.
     #[arg(long, allow_negative_numbers = true)]
     pub fan_angle: Option<f64>,
+    /// The core mesher: "tetgen" (default) or "native" (boundary recovery, no refinement yet).
+    #[arg(long, value_name = "MESHER")]
+    pub core_mesher: Option<crate::config::CoreMesherChoice>,
     /// Write only the layers (no core tetrahedra).
     #[arg(long)]
     pub no_core: bool,
@@ -75,6 +78,7 @@ impl Settings {
         config.feature_angle = self.feature_angle.or(config.feature_angle);
         config.fan_angle = self.fan_angle.or(config.fan_angle);
         config.peel_rounds = self.peel_rounds.or(config.peel_rounds);
+        config.core.mesher = self.core_mesher.or(config.core.mesher);
         if self.no_adapt {
             config.sizing.adapt = Some(false);
         }

@@ -27,6 +27,8 @@
 //! center = [0.0, 0.0, 0.0]
 //! radius = 1.1
 //! size = 0.02
+//! [core]
+//! mesher = "tetgen"            # or "native" (boundary recovery, no refinement yet; --core-mesher)
 //! [flow_conditions]            # for yplus: Re on a reference length (heights in its units)
 //! reynolds = 14.6e6
 //! length = 646.07
@@ -203,9 +205,42 @@ pub struct Config {
     pub patches: Vec<PatchRule>,
     #[serde(default)]
     pub sizing: SizingSettings,
+    #[serde(default)]
+    pub core: CoreSettings,
     /// Marches again at most with the stacks under the core's slivers a layer lower
     /// (default [`DEFAULT_PEEL_ROUNDS`]; 0: none).
     pub peel_rounds: Option<usize>,
+}
+
+/// The core fill's settings.
+#[derive(Clone, Debug, Default, Deserialize, Serialize)]
+#[serde(deny_unknown_fields)]
+pub struct CoreSettings {
+    /// Which mesher fills the core (default [`CoreMesherChoice::TetGen`]).
+    pub mesher: Option<CoreMesherChoice>,
+}
+
+/// The core mesher.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum CoreMesherChoice {
+    /// TetGen 1.5 (cargo feature `tetgen`), with its refinement and optimisation.
+    #[default]
+    TetGen,
+    /// The native mesher (`crate::fill::recover`): Delaunay, boundary recovery and the guide's
+    /// points; no refinement to the sizes yet.
+    Native,
+}
+
+impl std::str::FromStr for CoreMesherChoice {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "tetgen" => Ok(CoreMesherChoice::TetGen),
+            "native" => Ok(CoreMesherChoice::Native),
+            _ => Err(format!("core mesher must be \"tetgen\" or \"native\", got {s:?}")),
+        }
+    }
 }
 
 /// The sizes the layers' front is kept to while it marches (tangential adaptivity).

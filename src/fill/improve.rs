@@ -28,7 +28,7 @@ use crate::mesh::{sorted_edge, CellKind};
 pub use slide::{FrontSlides, MAX_SINK};
 
 /// No tetrahedron (across a boundary face).
-const NO_TET: u32 = u32::MAX;
+pub(crate) const NO_TET: u32 = u32::MAX;
 
 /// The local index of the node of `tet` that is not on its face `face`.
 fn opposite_node(tet: [u32; 4], face: [u32; 3]) -> usize {
@@ -160,6 +160,12 @@ pub struct Change {
 }
 
 impl Change {
+    /// A change judged by its caller (no qualities): tetrahedra `remove` replaced by `add`,
+    /// with the point moved or added as said.
+    pub(crate) fn replacing(remove: Vec<u32>, add: Vec<[u32; 4]>, point: Option<(u32, DVec3)>) -> Change {
+        Change { remove, add, point, before: 0.0, after: 0.0, below_before: 0, below_after: 0 }
+    }
+
     fn from_qualities(
         remove: Vec<u32>,
         add: Vec<[u32; 4]>,
@@ -481,7 +487,11 @@ impl TetMesh {
     /// Commit a change proposed by one of the operators.
     pub fn apply(&mut self, change: &Change) {
         self.applied += 1;
-        let moved_ball = change.point.filter(|_| change.remove.is_empty()).map(|(v, _)| v);
+        // A point moved (not added: a change may fill an empty cavity around a new point).
+        let moved_ball = change
+            .point
+            .filter(|&(v, _)| change.remove.is_empty() && (v as usize) < self.points.len())
+            .map(|(v, _)| v);
         let touched = change
             .remove
             .iter()
@@ -525,8 +535,33 @@ impl TetMesh {
         }
     }
 
+    /// Tetrahedron slots, live or removed: the bound of a tetrahedron index.
+    pub(crate) fn slots(&self) -> usize {
+        self.tets.len()
+    }
+
+    /// The nodes of tetrahedron slot `t` (removed or not).
+    pub(crate) fn tet(&self, t: u32) -> [u32; 4] {
+        self.tets[t as usize]
+    }
+
+    pub(crate) fn is_alive(&self, t: u32) -> bool {
+        self.alive[t as usize]
+    }
+
+    /// The tetrahedra across the faces opposite each node of live tetrahedron `t` ([`NO_TET`]
+    /// on the boundary).
+    pub(crate) fn adjacent(&self, t: u32) -> [u32; 4] {
+        self.adjacent[t as usize]
+    }
+
+    /// The live tetrahedra at point `v`.
+    pub(crate) fn ball(&self, v: u32) -> &[u32] {
+        &self.ball[v as usize]
+    }
+
     /// The live tetrahedra having all of `nodes`.
-    fn tets_with(&self, nodes: &[u32]) -> Vec<u32> {
+    pub(crate) fn tets_with(&self, nodes: &[u32]) -> Vec<u32> {
         let Some(&first) = nodes.first() else { return Vec::new() };
         self.ball[first as usize]
             .iter()
@@ -608,42 +643,15 @@ impl TetMesh {
     /// `(ri, rk, rj, b)` and `(rk, ri, rj, a)` over its triangles `i < k < j`; `None` when every
     /// triangulation has a tetrahedron that is not positive.
     fn best_ring_triangulation(&self, a: u32, b: u32, ring: &[u32]) -> Option<Vec<[u32; 4]>> {
-        let m = ring.len();
-        // best[i][j]: worst quality of the best triangulation of ring[i..=j]; split[i][j]: its apex.
-        let mut best = vec![vec![f64::INFINITY; m]; m];
-        let mut split = vec![vec![0usize; m]; m];
-        let pair = |i: usize, k: usize, j: usize| {
-            let (ri, rk, rj) = (ring[i], ring[k], ring[j]);
-            [[ri, rk, rj, b], [rk, ri, rj, a]]
-        };
-        for len in 2..m {
-            for i in 0..m - len {
-                let j = i + len;
-                best[i][j] = INVALID;
-                for k in i + 1..j {
-                    let q = best[i][k].min(best[k][j]).min(self.worst(pair(i, k, j)));
-                    if q > best[i][j] {
-                        best[i][j] = q;
-                        split[i][j] = k;
-                    }
-                }
-            }
-        }
-        if best[0][m - 1] <= INVALID {
-            return None;
-        }
-        let mut add = Vec::with_capacity(2 * (m - 2));
-        let mut stack = vec![(0, m - 1)];
-        while let Some((i, j)) = stack.pop() {
-            if j < i + 2 {
-                continue;
-            }
-            let k = split[i][j];
-            add.extend(pair(i, k, j));
-            stack.push((i, k));
-            stack.push((k, j));
-        }
-        Some(add)
+        let pair = |i: usize, k: usize, j: usize| ring_tets(a, b, ring, (i, k, j));
+        let triangles = best_polygon_triangulation(
+            ring.len(),
+            |i, k, j| self.worst(pair(i, k, j)),
+            f64::min,
+            f64::INFINITY,
+            INVALID,
+        )?;
+        Some(triangles.into_iter().flat_map(|(i, k, j)| pair(i, k, j)).collect())
     }
 
     /// Edge collapse: remove the added point `a` by merging it into `b`, a node of its star:
@@ -1116,6 +1124,60 @@ impl TetMesh {
     fn untouched_since(&self, tet: [u32; 4], at: usize) -> bool {
         tet.iter().all(|&v| self.touched[v as usize] <= at)
     }
+}
+
+/// The two tetrahedra that triangle `(i, k, j)` of the ring polygon around edge `ab` (see
+/// [`TetMesh::ring`]) makes with `a` and `b`, positive when the edge removal is valid there.
+pub(crate) fn ring_tets(a: u32, b: u32, ring: &[u32], (i, k, j): (usize, usize, usize)) -> [[u32; 4]; 2] {
+    let (ri, rk, rj) = (ring[i], ring[k], ring[j]);
+    [[ri, rk, rj, b], [rk, ri, rj, a]]
+}
+
+/// The triangulation of a convex `m`-gon (vertices `0..m`, as triangles `(i, k, j)` with
+/// `i < k < j`) that maximises the `join` of the `weight`s of its triangles, by dynamic
+/// programming (Shewchuk's for edge removal): `empty` is the value of no triangle, and `None`
+/// is returned when the best is not above `invalid`.
+pub(crate) fn best_polygon_triangulation(
+    m: usize,
+    weight: impl Fn(usize, usize, usize) -> f64,
+    join: impl Fn(f64, f64) -> f64,
+    empty: f64,
+    invalid: f64,
+) -> Option<Vec<(usize, usize, usize)>> {
+    if m < 3 {
+        return None;
+    }
+    // best[i][j]: the best triangulation of polygon i..=j; split[i][j]: its apex.
+    let mut best = vec![vec![empty; m]; m];
+    let mut split = vec![vec![0usize; m]; m];
+    for len in 2..m {
+        for i in 0..m - len {
+            let j = i + len;
+            best[i][j] = invalid;
+            for k in i + 1..j {
+                let q = join(join(best[i][k], best[k][j]), weight(i, k, j));
+                if q > best[i][j] {
+                    best[i][j] = q;
+                    split[i][j] = k;
+                }
+            }
+        }
+    }
+    if best[0][m - 1] <= invalid {
+        return None;
+    }
+    let mut triangles = Vec::with_capacity(m - 2);
+    let mut stack = vec![(0, m - 1)];
+    while let Some((i, j)) = stack.pop() {
+        if j < i + 2 {
+            continue;
+        }
+        let k = split[i][j];
+        triangles.push((i, k, j));
+        stack.push((i, k));
+        stack.push((k, j));
+    }
+    Some(triangles)
 }
 
 /// The centre of the sphere through the corners of a tetrahedron (none when it is flat).

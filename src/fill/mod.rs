@@ -15,6 +15,7 @@ pub mod improve;
 #[cfg(feature = "tetgen")]
 pub(crate) mod isolate;
 mod merge;
+pub mod recover;
 pub mod seeds;
 pub mod size_jump;
 #[cfg(feature = "tetgen")]
@@ -26,7 +27,7 @@ use serde::Serialize;
 
 pub use front::FrontLayer;
 
-use crate::config::{Config, FarfieldShape, Flow};
+use crate::config::{Config, CoreMesherChoice, FarfieldShape, Flow};
 use crate::geometry::{triangle_area_vector, DVec3};
 use crate::layers::sliding::SymmetryPlane;
 use crate::mesh::VolumeMesh;
@@ -280,7 +281,12 @@ pub enum FillError {
          it is a face of {tets} tetrahedra on its inner side"
     )]
     BoundaryNotKept { triangle: usize, nodes: [u32; 3], centre: [f64; 3], tets: usize },
-    #[error("blmesh was built without a core mesher (enable the cargo feature `tetgen`)")]
+    #[error("boundary recovery failed: {0}")]
+    Recovery(String),
+    #[error(
+        "blmesh was built without TetGen (enable the cargo feature `tetgen`, or choose the native \
+         core mesher: `--core-mesher native`, `[core] mesher = \"native\"`)"
+    )]
     NoMesher,
 }
 
@@ -312,6 +318,8 @@ pub struct CoreOptions {
     pub seed_front: bool,
     /// The core's sizes beyond the boundary's ([`grading`]); `None`: the mesher's own.
     pub sizing: Option<grading::CoreSizing>,
+    /// Which mesher fills the core.
+    pub mesher: CoreMesherChoice,
 }
 
 impl Default for CoreOptions {
@@ -322,6 +330,7 @@ impl Default for CoreOptions {
             improve: Default::default(),
             seed_front: true,
             sizing: Some(grading::CoreSizing::default()),
+            mesher: CoreMesherChoice::default(),
         }
     }
 }
@@ -340,6 +349,7 @@ impl CoreOptions {
                 max_size: config.sizing.max_size,
                 regions: config.sizing.regions.clone(),
             }),
+            mesher: config.core.mesher.unwrap_or_default(),
             ..Default::default()
         }
     }
@@ -380,7 +390,8 @@ pub struct CoreStats {
     pub mesher_seconds: f64,
 }
 
-/// Fill the core of a layered mesh with TetGen; see [`fill_core_with`].
+/// Fill the core of a layered mesh with the mesher of `options` (TetGen by default); see
+/// [`fill_core_with`].
 pub fn fill_core(
     layers: &VolumeMesh,
     wall: &Surface,
@@ -398,14 +409,16 @@ pub fn fill_core_on_symmetry_plane(
     options: &CoreOptions,
     symmetry: Option<&SymmetryPlane>,
 ) -> Result<(VolumeMesh, CoreStats), FillError> {
-    #[cfg(feature = "tetgen")]
-    {
-        fill_core_with_symmetry(&tetgen::TetGen::default(), layers, wall, options, symmetry)
-    }
-    #[cfg(not(feature = "tetgen"))]
-    {
-        let _ = (layers, wall, options, symmetry);
-        Err(FillError::NoMesher)
+    match options.mesher {
+        CoreMesherChoice::Native => {
+            fill_core_with_symmetry(&recover::NativeCore, layers, wall, options, symmetry)
+        }
+        #[cfg(feature = "tetgen")]
+        CoreMesherChoice::TetGen => {
+            fill_core_with_symmetry(&tetgen::TetGen::default(), layers, wall, options, symmetry)
+        }
+        #[cfg(not(feature = "tetgen"))]
+        CoreMesherChoice::TetGen => Err(FillError::NoMesher),
     }
 }
 

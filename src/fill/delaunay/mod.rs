@@ -73,7 +73,7 @@ const FREE: u32 = u32::MAX - 1;
 /// On an infinite tetrahedron, the hull face (opposite the infinite vertex) faces out of the
 /// hull: the tetrahedron is positive with a point far beyond the face in the infinite
 /// vertex's place.
-const FACES: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
+pub(crate) const FACES: [[usize; 3]; 4] = [[1, 3, 2], [0, 2, 3], [0, 3, 1], [0, 1, 2]];
 
 /// Seed of the insertion order's and the walk's random choices.
 const SEED: u64 = 0x5EED_DE1A_07A7_0001;
