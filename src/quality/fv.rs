@@ -273,11 +273,8 @@ pub fn wall_non_orthogonality(
 ) -> WallNonOrthogonality {
     let layered = |t: u32| layered_patch[surface.triangle_patch[t as usize] as usize];
     let at = |v: u32| surface.points[v as usize];
-    let centroid = |t: u32| surface.triangles[t as usize].map(at).iter().sum::<DVec3>() / 3.0;
-    let normal = |t: u32| {
-        let [a, b, c] = surface.triangles[t as usize].map(at);
-        crate::geometry::triangle_area_vector(a, b, c).normalize_or_zero()
-    };
+    let centroid = |t: u32| surface.triangle_points(t as usize).iter().sum::<DVec3>() / 3.0;
+    let normal = |t: u32| surface.triangle_normal(t as usize);
     let angles: Vec<(f64, u32)> = (0..topology.edge_count() as u32)
         .into_par_iter()
         .filter_map(|e| {
@@ -322,6 +319,34 @@ mod tests {
 
     fn close(a: f64, b: f64) -> bool {
         (a - b).abs() <= 1e-12 * (1.0 + b.abs())
+    }
+
+    /// A unit cube's faces, each cut along a diagonal, stay well below 70 deg (over a diagonal
+    /// the centroids lie square to it); sheared into long thin parallelograms, their diagonals'
+    /// faces pass 85 deg; patches without layers are left out.
+    #[test]
+    fn wall_non_orthogonality_is_that_of_thin_prisms_over_the_wall_edges() {
+        use crate::surface::shapes::cuboid;
+        let measure = |surface: &Surface, layered: &[bool]| {
+            wall_non_orthogonality(surface, &Topology::new(surface), layered)
+        };
+        let cube = cuboid(DVec3::ONE, 1);
+        let every = vec![true; cube.patch_names.len()];
+        let wall = measure(&cube, &every);
+        assert_eq!(wall.edges, 18);
+        assert_eq!((wall.edges_above_70, wall.edges_above_85), (0, 0));
+        // Over a cube's diagonal the centroids are square to it; over its edges they are not.
+        assert!(wall.max > 0.0 && wall.max < 70.0, "{wall:?}");
+        let none = measure(&cube, &vec![false; cube.patch_names.len()]);
+        assert_eq!((none.edges, none.max, none.worst_at), (0, 0.0, None));
+        // Sheared along x into a parallelogram 50 times longer than tall on its top: the top's
+        // diagonal runs nearly along x, and its centroids lie nearly along it.
+        let mut sheared = cube.clone();
+        for p in &mut sheared.points {
+            p.x = 50.0 * p.x + 50.0 * p.y;
+        }
+        let wall = measure(&sheared, &vec![true; sheared.patch_names.len()]);
+        assert!(wall.max > 85.0 && wall.edges_above_85 >= 1, "{wall:?}");
     }
 
     #[test]

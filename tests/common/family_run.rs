@@ -82,7 +82,7 @@ pub fn run_seed(family: Family, seed: u64, fineness: f64) -> SeedResult {
             valid: r.check.is_valid(),
             conforming: r.check.conformity.errors == 0,
             volume_identity: r.check.volume_identity_holds(),
-            solver_rejection: r.check.fv.rejection(),
+            solver_rejection: fv.rejection(),
             non_orthogonality_max: fv.non_orthogonality_max,
             faces_above_70_share: fv.faces_above_70 as f64 / fv.interior_faces.max(1) as f64,
             faces_above_85: fv.faces_above_85,
