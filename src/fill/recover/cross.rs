@@ -112,11 +112,7 @@ pub(super) fn projection(normal: DVec3) -> impl Fn(DVec3) -> [f64; 2] {
     } else {
         2
     };
-    move |p: DVec3| match drop {
-        0 => [p.y, p.z],
-        1 => [p.z, p.x],
-        _ => [p.x, p.y],
-    }
+    move |p: DVec3| crate::geometry::intersect::project(p, drop)
 }
 
 #[cfg(test)]
