@@ -18,7 +18,7 @@
 use std::collections::{HashMap, HashSet};
 
 use super::cross::Target;
-use super::recovery::{inward_faces, Recovery};
+use super::recovery::{cavity_faces, Recovery};
 use crate::fill::improve::NO_TET;
 use crate::geometry::predicates::{orient2d, orient3d, Sign};
 use crate::geometry::DVec3;
@@ -37,16 +37,10 @@ impl Recovery {
     /// The faces of the cavity of tetrahedra `cavity`, their normals pointing into it, and
     /// whether each has a tetrahedron across it.
     fn cavity_faces(&self, cavity: &[u32]) -> Vec<([u32; 3], Option<u32>)> {
-        let mut faces = Vec::new();
-        for &t in cavity {
-            let faces_of_t = inward_faces(self.mesh.tet(t));
-            for (i, &n) in self.mesh.adjacent(t).iter().enumerate() {
-                if !cavity.contains(&n) {
-                    faces.push((faces_of_t[i], (n != NO_TET).then_some(n)));
-                }
-            }
-        }
-        faces
+        cavity_faces(&self.mesh, cavity.iter().copied(), |n| cavity.contains(&n))
+            .into_iter()
+            .map(|(face, _, across)| (face, (across != NO_TET).then_some(across)))
+            .collect()
     }
 
     /// The cone from vertex `v` over the faces without it, if every tetrahedron is positive.

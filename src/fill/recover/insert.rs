@@ -151,16 +151,10 @@ pub(super) fn star_cavity(
 
 /// The faces of the cavity (normals into it) with the cavity's tetrahedron on each.
 fn cavity_faces(mesh: &TetMesh, cavity: &BTreeSet<u32>) -> Vec<([u32; 3], u32)> {
-    let mut faces = Vec::new();
-    for &t in cavity {
-        let inward = inward_faces(mesh.tet(t));
-        for (i, n) in mesh.adjacent(t).into_iter().enumerate() {
-            if !cavity.contains(&n) {
-                faces.push((inward[i], t));
-            }
-        }
-    }
-    faces
+    super::recovery::cavity_faces(mesh, cavity.iter().copied(), |n| cavity.contains(&n))
+        .into_iter()
+        .map(|(face, t, _)| (face, t))
+        .collect()
 }
 
 /// Keep only the tetrahedra of `cavity` connected to `start` through its faces.

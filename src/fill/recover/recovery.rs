@@ -27,6 +27,26 @@ pub(super) fn inward_faces(tet: [u32; 4]) -> [[u32; 3]; 4] {
     FACES.map(|f| f.map(|i| tet[i]))
 }
 
+/// The faces of the cavity made of the tetrahedra `cavity` (`inside` tells its members), their
+/// normals pointing into it: each with the cavity's tetrahedron on it and the one across
+/// ([`NO_TET`] on the boundary), in the order of `cavity` and of each tetrahedron's nodes.
+pub(super) fn cavity_faces(
+    mesh: &TetMesh,
+    cavity: impl IntoIterator<Item = u32>,
+    inside: impl Fn(u32) -> bool,
+) -> Vec<([u32; 3], u32, u32)> {
+    let mut faces = Vec::new();
+    for t in cavity {
+        let inward = inward_faces(mesh.tet(t));
+        for (i, n) in mesh.adjacent(t).into_iter().enumerate() {
+            if !inside(n) {
+                faces.push((inward[i], t, n));
+            }
+        }
+    }
+    faces
+}
+
 /// The sorted faces of a tetrahedron.
 fn tet_faces(tet: [u32; 4]) -> [[u32; 3]; 4] {
     inward_faces(tet).map(sorted_triangle)
