@@ -349,6 +349,19 @@ fn lip_fans_meeting_over_a_filled_groove_merge_into_its_crease() {
     assert_near_concave("family groove 15", &out.report.layers, 0.7);
 }
 
+/// A wing on a plate of the randomised family (seed 0: its trailing edge leans over the plate
+/// behind the root) at the families' spec, layers only: the trailing edge's fan, turned down
+/// towards the plate near the root, meets the plate's front head on. The fan's columns that the
+/// plate's front reached first merge into their fan mates and the fan goes on above them;
+/// stopping both fronts' columns there left 71.7% of the vertices near the root with their full
+/// stack.
+#[test]
+fn a_trailing_edge_fan_over_the_plate_retreats_where_the_plate_front_meets_it() {
+    let out = family_layers(Family::WingPlate, 0);
+    common::assert_valid_for_a_solver("family wing-plate 0", &out.report.check);
+    assert_near_concave("family wing-plate 0", &out.report.layers, 0.78);
+}
+
 /// A wing on a plate of the randomised family (seed 2) at the families' spec, layers only: where
 /// the plate's and the wing's face columns merge into the root's, faces end up with their three
 /// columns along the root, slivers lying in the front's crease that pinch it; they are swapped

@@ -25,7 +25,9 @@
 //! that leaves every cell around valid mends it ([`merge_to_mend`]). Last, two faces whose tops
 //! cross over a front edge they share (two fronts closing a V over the crease where they met,
 //! as a groove's lip fans do over its filled mouth) merge their columns into the crease instead
-//! of stopping ([`merge_into_crease`]).
+//! of stopping ([`merge_into_crease`]); where crossing faces share no edge but one is a fan
+//! strip, fronts met head on over a convex ridge, and the fan columns the other front reached
+//! first merge into their fan mates ([`retreat_fans`]).
 
 use glam::DVec3;
 use rayon::prelude::*;
@@ -878,6 +880,63 @@ pub(super) fn merge_into_crease(
     }
     *plan = saved;
     None
+}
+
+/// Where two faces whose tops cross are fan strips of a convex ridge or corner (or one of them
+/// is), fronts met head on over them: the lips' fans over a groove's filled mouth, a trailing
+/// edge's fan leaning over the wall below it. A fan column's characteristic ends where another
+/// front reached its top first, so on each fan edge of the two faces the column nearer the
+/// other face merges into its fan mate, which keeps its top: the fan shrinks to the columns the
+/// other front has not reached, and its wall point's stack goes on in them. The guard tests the
+/// faces around again; the next strip retreats in turn if it crosses too. Returns the columns
+/// whose cells changed, or `None` (the plan as it was) where neither face has a fan edge whose
+/// columns can merge, or the merges leave more invalid cells around than there were.
+pub(super) fn retreat_fans(
+    plan: &mut SlabPlan,
+    front: &Front,
+    columns: &Columns,
+    (f, g): (usize, usize),
+    invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
+) -> Option<Vec<u32>> {
+    let (pf, pg) = (plan.merges.resolved_face(front, f)?, plan.merges.resolved_face(front, g)?);
+    let top = |c: u32| plan.proposed[c as usize];
+    let centre = |p: &Polygon| p.nodes().iter().map(|&c| top(c)).sum::<DVec3>() / p.nodes().len() as f64;
+    let mut retreats: Vec<(u32, u32)> = Vec::new();
+    for (p, other) in [(&pf, centre(&pg)), (&pg, centre(&pf))] {
+        let n = p.nodes();
+        for i in 0..n.len() {
+            let (a, b) = (n[i], n[(i + 1) % n.len()]);
+            if columns.is_fan_edge(a as usize, b as usize) {
+                let near = |c: u32| top(c).distance_squared(other);
+                retreats.push(if near(a) < near(b) { (b, a) } else { (a, b) });
+            }
+        }
+    }
+    let roots: Vec<u32> = retreats.iter().flat_map(|&(keep, drop)| [keep, drop]).collect();
+    let around = |plan: &SlabPlan| -> Vec<u32> {
+        let mut group: Vec<u32> =
+            roots.iter().flat_map(|&c| plan.merges.group(plan.merges.root(c))).collect();
+        group.sort_unstable();
+        group.dedup();
+        group
+    };
+    let before = invalid_cells(plan, &around(plan));
+    let saved = plan.clone();
+    let mut merged = false;
+    for (keep, drop) in retreats {
+        let (keep, drop) = (plan.merges.root(keep), plan.merges.root(drop));
+        if can_merge_fan_mate(plan, front, columns, keep, drop) {
+            merge_as(plan, columns, (keep, drop, false));
+            merged = true;
+        }
+    }
+    let group = around(plan);
+    if !merged || invalid_cells(plan, &group) > before {
+        *plan = saved;
+        return None;
+    }
+    tracing::debug!(f, g, at = ?columns.base[pf.nodes()[0] as usize], "fronts met head on: fans retreated");
+    Some(group)
 }
 
 /// Where a V's columns merging into its crease may meet, as parts of the way from the crease's

@@ -814,6 +814,10 @@ fn settle_slab(
                 changed.extend(merged);
                 continue;
             }
+            if let Some(merged) = entropy::retreat_fans(&mut plan, front, columns, (f, g), &invalid_cells) {
+                changed.extend(merged);
+                continue;
+            }
             let stopped = stop_to_uncross(&mut plan, front, columns, f, g);
             plan.uncrossed.extend(&stopped);
             changed.extend(stopped);
