@@ -349,6 +349,19 @@ fn lip_fans_meeting_over_a_filled_groove_merge_into_its_crease() {
     assert_near_concave("family groove 15", &out.report.layers, 0.7);
 }
 
+/// A groove of the randomised family (seed 11: 45 degrees, its mouth narrower than the layers
+/// are thick) at the families' spec, layers only: the lips' fans close a V over the crease the
+/// walls' merges left along the whole groove in one layer. Merged pair by pair, each raise of
+/// the crease stepped it up beside the next pair's, whose cell turned over, and every lip's
+/// stack stopped: 20.9% of the vertices near the bottom kept their full stack. The V closes
+/// along its crease at once.
+#[test]
+fn a_v_closing_along_a_groove_closes_at_once() {
+    let out = family_layers(Family::Grooves, 11);
+    common::assert_valid_for_a_solver("family groove 11", &out.report.check);
+    assert_near_concave("family groove 11", &out.report.layers, 0.85);
+}
+
 /// A wing on a plate of the randomised family (seed 0: its trailing edge leans over the plate
 /// behind the root) at the families' spec, layers only: the trailing edge's fan, turned down
 /// towards the plate near the root, meets the plate's front head on. The fan's columns that the

@@ -801,17 +801,149 @@ pub(super) fn merge_to_mend(
 /// fill: each lip's fan strip rises from the crease, and the exact fronts meet there at a cusp,
 /// nearly closed right after they meet). The V's columns on both sides of each end of that edge
 /// meet there: they merge into the edge's column, whose top goes to the middle of theirs (on the
-/// medial surface, where the fronts cross next), when that uncrosses the two faces (`crosses`)
-/// and leaves every cell around valid. Returns the columns whose tops moved, or `None` (the
-/// plan as it was) where the faces share no edge or the merge does not help.
+/// medial surface, where the fronts cross next), when that uncrosses the faces (`crosses`) and
+/// leaves every cell around valid. `pairs` are all the pairs crossing over a shared edge that
+/// close at once (the V along a whole groove): each end of the crease that several pairs share
+/// takes the columns of all of them, and the crease rises alike along its whole length, where
+/// raising it pair by pair stepped it up beside the pair next to it, whose cell turned over.
+/// Returns the columns whose tops moved, or `None` (the plan as it was) where the faces share no
+/// edge or the merge does not help.
 pub(super) fn merge_into_crease(
     plan: &mut SlabPlan,
     front: &Front,
     columns: &Columns,
-    (f, g): (usize, usize),
+    pairs: &[(usize, usize)],
     crosses: &impl Fn(&SlabPlan) -> bool,
     invalid_cells: &impl Fn(&SlabPlan, &[u32]) -> usize,
 ) -> Option<Vec<u32>> {
+    // Each V column merges into one end (the first pair's that names it).
+    let mut meeting_at: Vec<(u32, Vec<u32>)> = Vec::new();
+    for &pair in pairs {
+        for (r, meeting) in crease_meetings(plan, front, pair)? {
+            let fresh: Vec<u32> =
+                meeting.into_iter().filter(|c| !meeting_at.iter().any(|m| m.1.contains(c))).collect();
+            match meeting_at.iter_mut().find(|m| m.0 == r) {
+                Some((_, all)) => all.extend(fresh),
+                None if !fresh.is_empty() => meeting_at.push((r, fresh)),
+                None => {}
+            }
+        }
+    }
+    if meeting_at.is_empty() {
+        return None;
+    }
+    // Each end of the crease, its top and the middle of its meeting columns' tops.
+    let top = |c: u32| plan.proposed[c as usize];
+    let meetings: Vec<(u32, DVec3, DVec3)> = meeting_at
+        .iter()
+        .map(|(r, meeting)| {
+            (*r, top(*r), meeting.iter().map(|&c| top(c)).sum::<DVec3>() / meeting.len() as f64)
+        })
+        .collect();
+    let saved = plan.clone();
+    for (r, meeting) in &meeting_at {
+        for &c in meeting {
+            let c = plan.merges.root(c);
+            if c == *r {
+                continue;
+            }
+            if !can_merge(plan, front, columns, *r, c) {
+                *plan = saved;
+                return None;
+            }
+            merge_as(plan, columns, (*r, c, false));
+        }
+    }
+    // Every column whose top moved: the crease's ends carry the tops of the columns merged into
+    // them, now and before.
+    let group: Vec<u32> = meetings.iter().flat_map(|m| plan.merges.group(m.0)).collect();
+    // The highest meeting point, from the middle of the V down to the crease's top, that keeps
+    // every cell valid: the crease's column carries cells below it that a jump up turns over,
+    // the V's columns fan cells that a drop onto the crease does.
+    for part in MEETING_HEIGHTS {
+        for &(r, crease_top, middle) in &meetings {
+            plan.proposed[r as usize] = columns.slide[r as usize].project(crease_top.lerp(middle, part));
+        }
+        if !crosses(plan) && invalid_cells(plan, &group) == 0 {
+            tracing::debug!(
+                ?pairs,
+                ?group,
+                part,
+                "crossing faces over a shared edge: merged into the crease"
+            );
+            return Some(group);
+        }
+    }
+    *plan = saved;
+    None
+}
+
+/// The crossing pairs of `pairs` that close a V over a shared edge ([`merge_into_crease`]),
+/// grouped along their creases: two pairs are in one group when an end of one's crease is an
+/// end of the other's or next to one on the front. Each group is one V closing along its crease
+/// (the crease edges between its pairs may not cross yet, their neighbours on both sides do).
+pub(super) fn crease_groups(
+    plan: &SlabPlan,
+    front: &Front,
+    pairs: &[(usize, usize)],
+) -> Vec<Vec<(usize, usize)>> {
+    /// A creased pair, its crease's ends, and those ends with the roots next to them (sorted).
+    struct Creased {
+        pair: (usize, usize),
+        ends: Vec<u32>,
+        near: Vec<u32>,
+    }
+    let mut creased: Vec<Creased> = Vec::new();
+    let mut beside = Vec::new();
+    for &pair in pairs {
+        let Some(meetings) = crease_meetings(plan, front, pair).filter(|m| !m.is_empty()) else { continue };
+        let ends: Vec<u32> = meetings.iter().map(|m| m.0).collect();
+        let mut near: Vec<u32> = ends.clone();
+        for &r in &ends {
+            for c in plan.merges.group(r) {
+                beside.clear();
+                front.neighbours(c as usize, &mut beside);
+                near.extend(beside.iter().map(|&n| plan.merges.root(n as u32)));
+            }
+        }
+        near.sort_unstable();
+        near.dedup();
+        creased.push(Creased { pair, ends, near });
+    }
+    // Connected components of "an end of one is near the other's" (union-find).
+    let mut parent: Vec<usize> = (0..creased.len()).collect();
+    let find = |parent: &mut Vec<usize>, mut i: usize| {
+        while parent[i] != i {
+            parent[i] = parent[parent[i]];
+            i = parent[i];
+        }
+        i
+    };
+    for (i, a) in creased.iter().enumerate() {
+        for (j, b) in creased.iter().enumerate().skip(i + 1) {
+            if a.ends.iter().any(|r| b.near.binary_search(r).is_ok()) {
+                let (x, y) = (find(&mut parent, i), find(&mut parent, j));
+                parent[x.max(y)] = x.min(y);
+            }
+        }
+    }
+    let mut groups: Vec<Vec<(usize, usize)>> = Vec::new();
+    let mut slot_of: Vec<Option<usize>> = vec![None; creased.len()];
+    for (i, c) in creased.iter().enumerate() {
+        let root = find(&mut parent, i);
+        let slot = *slot_of[root].get_or_insert_with(|| {
+            groups.push(Vec::new());
+            groups.len() - 1
+        });
+        groups[slot].push(c.pair);
+    }
+    groups
+}
+
+/// The ends of the edge that crossing faces `(f, g)` share (after the merges), each with the
+/// columns of the V beside it on both faces; `None` where they share no edge, an empty list
+/// where no end has V columns on both sides.
+fn crease_meetings(plan: &SlabPlan, front: &Front, (f, g): (usize, usize)) -> Option<Vec<(u32, Vec<u32>)>> {
     let (pf, pg) = (plan.merges.resolved_face(front, f)?, plan.merges.resolved_face(front, g)?);
     let crease = shared_edge(pf.nodes(), pg.nodes())?;
     // Each corner of a face off the crease, with the end of the crease beside it (the nearer
@@ -833,53 +965,17 @@ pub(super) fn merge_into_crease(
             .collect()
     };
     let (sides_f, sides_g) = (off_crease(&pf), off_crease(&pg));
-    // Each end of the crease where the V's columns from both faces meet: the end, those columns,
-    // its top and the middle of theirs.
-    let meetings: Vec<(u32, Vec<u32>, DVec3, DVec3)> = crease
-        .into_iter()
-        .filter_map(|r| {
-            let at_r =
-                |side: &[(u32, u32)]| side.iter().filter(|m| m.1 == r).map(|m| m.0).collect::<Vec<u32>>();
-            let (a, b) = (at_r(&sides_f), at_r(&sides_g));
-            if a.is_empty() || b.is_empty() {
-                return None;
-            }
-            let meeting: Vec<u32> = a.into_iter().chain(b).collect();
-            let middle =
-                meeting.iter().map(|&c| plan.proposed[c as usize]).sum::<DVec3>() / meeting.len() as f64;
-            Some((r, meeting, plan.proposed[r as usize], middle))
-        })
-        .collect();
-    if meetings.is_empty() {
-        return None;
-    }
-    let saved = plan.clone();
-    for (r, meeting, _, _) in &meetings {
-        for &c in meeting {
-            if !can_merge(plan, front, columns, *r, c) {
-                *plan = saved;
-                return None;
-            }
-            merge_as(plan, columns, (*r, c, false));
-        }
-    }
-    // Every column whose top moved: the crease's ends carry the tops of the columns merged into
-    // them, now and before.
-    let group: Vec<u32> = meetings.iter().flat_map(|m| plan.merges.group(m.0)).collect();
-    // The highest meeting point, from the middle of the V down to the crease's top, that keeps
-    // every cell valid: the crease's column carries cells below it that a jump up turns over,
-    // the V's columns fan cells that a drop onto the crease does.
-    for part in MEETING_HEIGHTS {
-        for &(r, _, crease_top, middle) in &meetings {
-            plan.proposed[r as usize] = columns.slide[r as usize].project(crease_top.lerp(middle, part));
-        }
-        if !crosses(plan) && invalid_cells(plan, &group) == 0 {
-            tracing::debug!(f, g, ?group, part, "crossing faces over a shared edge: merged into the crease");
-            return Some(group);
-        }
-    }
-    *plan = saved;
-    None
+    let at =
+        |side: &[(u32, u32)], r: u32| side.iter().filter(|m| m.1 == r).map(|m| m.0).collect::<Vec<u32>>();
+    Some(
+        crease
+            .into_iter()
+            .filter_map(|r| {
+                let (a, b) = (at(&sides_f, r), at(&sides_g, r));
+                (!a.is_empty() && !b.is_empty()).then(|| (r, a.into_iter().chain(b).collect()))
+            })
+            .collect(),
+    )
 }
 
 /// Where two faces whose tops cross are fan strips of a convex ridge or corner (or one of them

@@ -800,6 +800,27 @@ fn settle_slab(
         let mut changed = Vec::new();
         let invalid_cells =
             |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
+        // A V closing along a crease closes at once (and its merges may make the next crease).
+        let pair_crosses = |plan: &SlabPlan, (f, g): (usize, usize)| {
+            CrossingGuard::pair_crosses(plan, reshape, mesh, columns, front, f, g)
+        };
+        loop {
+            let crossing: Vec<(usize, usize)> =
+                crossings.pairs.iter().copied().filter(|&pair| pair_crosses(&plan, pair)).collect();
+            let mut merged_any = false;
+            for pairs in entropy::crease_groups(&plan, front, &crossing).into_iter().filter(|p| p.len() > 1) {
+                let crosses = |plan: &SlabPlan| pairs.iter().any(|&pair| pair_crosses(plan, pair));
+                if let Some(merged) =
+                    entropy::merge_into_crease(&mut plan, front, columns, &pairs, &crosses, &invalid_cells)
+                {
+                    changed.extend(merged);
+                    merged_any = true;
+                }
+            }
+            if !merged_any {
+                break;
+            }
+        }
         for (f, g) in crossings.pairs {
             // An earlier stop or merge may have uncrossed them (fronts meeting head on across a
             // gap both stop, at the medial surface).
@@ -809,7 +830,7 @@ fn settle_slab(
                 continue;
             }
             if let Some(merged) =
-                entropy::merge_into_crease(&mut plan, front, columns, (f, g), &crosses, &invalid_cells)
+                entropy::merge_into_crease(&mut plan, front, columns, &[(f, g)], &crosses, &invalid_cells)
             {
                 changed.extend(merged);
                 continue;
