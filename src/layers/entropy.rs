@@ -819,7 +819,7 @@ pub(super) fn merge_into_crease(
     // Each V column merges into one end (the first pair's that names it).
     let mut meeting_at: Vec<(u32, Vec<u32>)> = Vec::new();
     for &pair in pairs {
-        for (r, meeting) in crease_meetings(plan, front, pair)? {
+        for (r, meeting) in crease_meetings(plan, front, pair, pairs.len() == 1)? {
             let fresh: Vec<u32> =
                 meeting.into_iter().filter(|c| !meeting_at.iter().any(|m| m.1.contains(c))).collect();
             match meeting_at.iter_mut().find(|m| m.0 == r) {
@@ -865,6 +865,7 @@ pub(super) fn merge_into_crease(
             plan.proposed[r as usize] = columns.slide[r as usize].project(crease_top.lerp(middle, part));
         }
         if !crosses(plan) && invalid_cells(plan, &group) == 0 {
+            redirect_creases(plan, columns, &meeting_at);
             tracing::debug!(
                 ?pairs,
                 ?group,
@@ -876,6 +877,22 @@ pub(super) fn merge_into_crease(
     }
     *plan = saved;
     None
+}
+
+/// Once a V has closed on its crease, each end goes on along the mean direction `m` of the V's
+/// columns it took, as the meeting line of their offsets does: at `1 / (d . m)` for columns
+/// along `d` (a concave ridge's bisector rule; their mean scale over the mean of `d . m`). The
+/// crease column's own scale (a narrow groove's bottom bisector: 1 / sin of half its angle)
+/// ran it ever farther ahead of the front above the closed V.
+fn redirect_creases(plan: &mut SlabPlan, columns: &Columns, meetings: &[(u32, Vec<u32>)]) {
+    for (r, meeting) in meetings {
+        let v: Vec<usize> = meeting.iter().map(|&c| c as usize).collect();
+        let Some(dir) = v.iter().map(|&c| columns.dir[c]).sum::<DVec3>().try_normalize() else { continue };
+        let mean = |x: &dyn Fn(usize) -> f64| v.iter().map(|&c| x(c)).sum::<f64>() / v.len() as f64;
+        let cos = mean(&|c| columns.dir[c].dot(dir));
+        let scale = if cos > 0.0 { (mean(&|c| columns.scale[c]) / cos).max(1.0) } else { continue };
+        plan.redirected.push((*r, dir, scale));
+    }
 }
 
 /// The crossing pairs of `pairs` that close a V over a shared edge ([`merge_into_crease`]),
@@ -896,7 +913,9 @@ pub(super) fn crease_groups(
     let mut creased: Vec<Creased> = Vec::new();
     let mut beside = Vec::new();
     for &pair in pairs {
-        let Some(meetings) = crease_meetings(plan, front, pair).filter(|m| !m.is_empty()) else { continue };
+        let Some(meetings) = crease_meetings(plan, front, pair, false).filter(|m| !m.is_empty()) else {
+            continue;
+        };
         let ends: Vec<u32> = meetings.iter().map(|m| m.0).collect();
         let mut near: Vec<u32> = ends.clone();
         for &r in &ends {
@@ -943,9 +962,16 @@ pub(super) fn crease_groups(
 /// The ends of the edge that crossing faces `(f, g)` share (after the merges), each with the
 /// columns of the V beside it on both faces; `None` where they share no edge, an empty list
 /// where no end has V columns on both sides.
-fn crease_meetings(plan: &SlabPlan, front: &Front, (f, g): (usize, usize)) -> Option<Vec<(u32, Vec<u32>)>> {
+fn crease_meetings(
+    plan: &SlabPlan,
+    front: &Front,
+    (f, g): (usize, usize),
+    or_corner: bool,
+) -> Option<Vec<(u32, Vec<u32>)>> {
     let (pf, pg) = (plan.merges.resolved_face(front, f)?, plan.merges.resolved_face(front, g)?);
-    let crease = shared_edge(pf.nodes(), pg.nodes())?;
+    let Some(crease) = shared_edge(pf.nodes(), pg.nodes()) else {
+        return vertex_meeting(plan, &pf, &pg).filter(|_| or_corner).map(|m| vec![m]);
+    };
     // Each corner of a face off the crease, with the end of the crease beside it (the nearer
     // one for a triangle's apex).
     let off_crease = |p: &Polygon| -> Vec<(u32, u32)> {
@@ -976,6 +1002,24 @@ fn crease_meetings(plan: &SlabPlan, front: &Front, (f, g): (usize, usize)) -> Op
             })
             .collect(),
     )
+}
+
+/// Where two crossing faces share one corner and no edge (two triangles beside a ridge column,
+/// one on each wall, whose far corners passed its bisector with no collapse), the V closes at
+/// that corner: from each face, the corner beside it nearest the other face meets there.
+fn vertex_meeting(plan: &SlabPlan, pf: &Polygon, pg: &Polygon) -> Option<(u32, Vec<u32>)> {
+    let shared: Vec<u32> = pf.nodes().iter().copied().filter(|c| pg.nodes().contains(c)).collect();
+    let &[r] = shared.as_slice() else { return None };
+    let top = |c: u32| plan.proposed[c as usize];
+    let centre = |p: &Polygon| p.nodes().iter().map(|&c| top(c)).sum::<DVec3>() / p.nodes().len() as f64;
+    let nearest_beside = |p: &Polygon, other: DVec3| {
+        let n = p.nodes();
+        let i = n.iter().position(|&c| c == r)?;
+        [n[(i + 1) % n.len()], n[(i + n.len() - 1) % n.len()]]
+            .into_iter()
+            .min_by(|&a, &b| top(a).distance_squared(other).total_cmp(&top(b).distance_squared(other)))
+    };
+    Some((r, vec![nearest_beside(pf, centre(pg))?, nearest_beside(pg, centre(pf))?]))
 }
 
 /// Where two faces whose tops cross are fan strips of a convex ridge or corner (or one of them
