@@ -43,7 +43,7 @@ fn locate(mesh: &TetMesh, hints: &[u32], p: DVec3) -> Option<u32> {
 }
 
 /// The visibility walk of [`locate`] from `hint`; `None` when it leaves the region.
-fn walk(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
+pub(super) fn walk(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
     let beyond = |t: u32, i: usize| {
         let f = inward_faces(mesh.tet(t))[i];
         let [a, b, c] = f.map(|v| mesh.points[v as usize]);
