@@ -55,6 +55,7 @@ use serde::Serialize;
 use self::cross::Target;
 use self::recovery::Recovery;
 use super::delaunay::Delaunay;
+use super::grading::CoreSizing;
 use super::improve::TetMesh;
 use super::{ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
 use crate::geometry::DVec3;
@@ -76,9 +77,27 @@ impl CoreMesher for NativeCore {
     fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError> {
         self.fill_refined(boundary, guide).map(|(core, _)| core)
     }
+
+    fn grades(&self) -> bool {
+        self.refine.gradation.is_some()
+    }
 }
 
 impl NativeCore {
+    /// The native core grading its sizes as it refines, by `sizing`'s gradation and under its
+    /// maximum size: one fill gives the graded core. Not with refinement regions (their
+    /// sizes are sampled from a first fill by the graded second fill, [`crate::fill::grading`]),
+    /// nor without `sizing`.
+    pub fn graded(sizing: Option<&CoreSizing>) -> NativeCore {
+        let Some(sizing) = sizing.filter(|s| s.regions.is_empty()) else { return NativeCore::default() };
+        let refine = refine::RefineOptions {
+            gradation: Some(sizing.gradation),
+            max_size: sizing.max_size,
+            ..Default::default()
+        };
+        NativeCore { refine }
+    }
+
     /// [`CoreMesher::fill`], and what the refinement did.
     pub fn fill_refined(
         &self,
@@ -97,9 +116,7 @@ impl NativeCore {
         let skipped: Vec<insert::Skipped> = inserted.iter().filter_map(|r| r.err()).collect();
         tracing::info!(?stats, ?skipped, of = guide.interior.len(), "native core: boundary recovered");
         let mut size = point_sizes(&mesh, guide, n, &inserted);
-        let mut refinement =
-            refine::Refinement { mesh: &mut mesh, size: &mut size, boundary: &bvh, options: &self.refine };
-        let refined = refinement.run();
+        let refined = refine::Refinement::new(&mut mesh, &mut size, &bvh, &self.refine).run();
         tracing::info!(?refined, points = mesh.points.len(), "native core: refined");
         let (points, tets) = mesh.into_parts();
         let mut core = CoreTets { points, tets, boundary_steiner_points: 0 };

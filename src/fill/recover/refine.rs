@@ -15,12 +15,13 @@
 //!
 //! A point is rejected where it would spoil the boundary's tetrahedra rather than split the
 //! boundary: outside the region (the walk to it leaves it), nearer a boundary triangle than
-//! [`RefineOptions::clearance`] local sizes, inside the diametral sphere of a boundary
+//! [`RefineOptions::clearance`] sizes, inside the diametral sphere of a boundary
 //! triangle its cavity reaches (encroachment: the triangle's new tetrahedron would have an
-//! angle of 90 degrees or more at the point), or nearer a vertex than
-//! [`RefineOptions::spacing`] times the shortest edge of what it splits. A too large
+//! angle of 90 degrees or more at the point), nearer a vertex than [`RefineOptions::spacing`]
+//! times the local size, or with a cavity of more than [`RefineOptions::max_cavity`] tetrahedra. A too large
 //! tetrahedron whose circumcentre is rejected is tried at points towards its centroid; one
-//! left unsplit is taken up again in a later pass only (its neighbourhood may have changed).
+//! left unsplit is taken up again in a later pass only (its neighbourhood may have changed),
+//! unless every rejection was for a reason that lasts (outside, near the boundary or a vertex).
 //! The refinement ends when no tetrahedron is bad, or after [`RefineOptions::passes`] passes,
 //! or at [`RefineOptions::max_points`] points added.
 
@@ -48,12 +49,22 @@ pub struct RefineOptions {
     /// size at its corners (TetGen's `-m` rule, with the factor of the TetGen path:
     /// [`crate::fill::CIRCUMRADIUS_PER_SIZE`]).
     pub circumradius_per_size: f64,
-    /// No point nearer a boundary triangle than this many local sizes (the first core cells
-    /// on the front stay the seeds').
+    /// No point nearer a boundary triangle than this many times the size interpolated there
+    /// (the first core cells on the front stay the seeds'; in a gap narrower than its sizes,
+    /// no point goes in).
     pub clearance: f64,
-    /// No point nearer a vertex than this many times the shortest edge of the tetrahedron it
-    /// splits.
+    /// No point nearer a vertex than this many times the size interpolated there (the shortest
+    /// edge of the tetrahedron it splits where there are no sizes). Near a size much smaller
+    /// than its surroundings' this stops the refinement short of it (edges up to about 4 times
+    /// the size at such a point); allowing the smallest size at the tetrahedron's corners
+    /// instead tripled the points in mech_test_gapdetection's gaps. With sizes, points stay apart, so the
+    /// refinement ends even near small angles of the boundary, where radius-edge refinement
+    /// alone would not.
     pub spacing: f64,
+    /// Tetrahedra at most in the cavity of a point (a bound on the work of one insertion; the
+    /// first points in the coarse tetrahedralisation of the boundary have cavities of
+    /// thousands).
+    pub max_cavity: usize,
     /// Points added at most.
     pub max_points: usize,
     /// Passes over the tetrahedra left bad at most.
@@ -62,6 +73,9 @@ pub struct RefineOptions {
     /// `gradation - 1` times its distance to it (sizes graded as they are made); `None`:
     /// interpolated only.
     pub gradation: Option<f64>,
+    /// No size above this (the user's maximum size, `[sizing] max_size`) at the corners of a
+    /// tetrahedron or at an added point; `None`: no bound.
+    pub max_size: Option<f64>,
 }
 
 impl Default for RefineOptions {
@@ -71,9 +85,11 @@ impl Default for RefineOptions {
             circumradius_per_size: crate::fill::CIRCUMRADIUS_PER_SIZE,
             clearance: 0.5,
             spacing: 0.5,
+            max_cavity: 100_000,
             max_points: (crate::fill::grading::MAX_CORE_TETRAHEDRA / 5.0) as usize,
             passes: 3,
             gradation: None,
+            max_size: None,
         }
     }
 }
@@ -150,15 +166,36 @@ impl Ord for Bad {
 }
 
 /// The refinement under way: the mesh, the size at every point (NaN: none, as for points no
-/// tetrahedron uses) and the boundary triangles for the clearance.
+/// tetrahedron uses), the boundary triangles for the clearance, and the tetrahedron slots
+/// given up (every point for them rejected for a reason a later pass cannot change).
 pub(super) struct Refinement<'a> {
-    pub mesh: &'a mut TetMesh,
-    pub size: &'a mut Vec<f64>,
-    pub boundary: &'a TriangleBvh,
-    pub options: &'a RefineOptions,
+    mesh: &'a mut TetMesh,
+    size: &'a mut Vec<f64>,
+    boundary: &'a TriangleBvh,
+    options: &'a RefineOptions,
+    given_up: Vec<bool>,
 }
 
-impl Refinement<'_> {
+impl Rejected {
+    /// Whether the same point is rejected again while the tetrahedron lives: the boundary does
+    /// not change, and refinement only adds vertices.
+    fn lasting(self) -> bool {
+        matches!(self, Rejected::Outside | Rejected::NearBoundary | Rejected::NearVertex)
+    }
+}
+
+impl<'a> Refinement<'a> {
+    /// `size` has an entry for every point of `mesh`; `boundary` holds the corners of the
+    /// region's boundary triangles.
+    pub fn new(
+        mesh: &'a mut TetMesh,
+        size: &'a mut Vec<f64>,
+        boundary: &'a TriangleBvh,
+        options: &'a RefineOptions,
+    ) -> Self {
+        Refinement { mesh, size, boundary, options, given_up: Vec::new() }
+    }
+
     /// Refine until no tetrahedron is bad or a limit is reached (see the module
     /// documentation).
     pub fn run(&mut self) -> RefineStats {
@@ -184,12 +221,16 @@ impl Refinement<'_> {
                 let first_new = self.mesh.slots() as u32;
                 if self.split(&bad, &mut stats) {
                     queue.extend(self.bad_tets(first_new..self.mesh.slots() as u32));
+                    if (stats.for_size + stats.for_quality) % 100_000 == 0 {
+                        tracing::debug!(?stats, queued = queue.len(), ?bad, "refinement under way");
+                    }
                 }
             }
             if stats.point_limit || stats.for_size + stats.for_quality == before {
                 break;
             }
         }
+        self.given_up.clear();
         for bad in self.bad_tets(0..self.mesh.slots() as u32) {
             *(if bad.too_large { &mut stats.left_too_large } else { &mut stats.left_poorly_shaped }) += 1;
         }
@@ -197,9 +238,10 @@ impl Refinement<'_> {
         stats
     }
 
-    /// The bad live tetrahedra among the slots `slots`.
+    /// The bad live tetrahedra among the slots `slots`, but those given up.
     fn bad_tets(&self, slots: std::ops::Range<u32>) -> impl Iterator<Item = Bad> + '_ {
-        slots.filter(|&t| self.mesh.is_alive(t)).filter_map(|t| self.assess(t))
+        let given_up = |t: u32| self.given_up.get(t as usize).copied().unwrap_or(false);
+        slots.filter(move |&t| self.mesh.is_alive(t) && !given_up(t)).filter_map(|t| self.assess(t))
     }
 
     /// Whether live tetrahedron `t` is too large or poorly shaped, and how much.
@@ -212,7 +254,8 @@ impl Refinement<'_> {
             .into_iter()
             .min_by(|&(a, b), &(c, d)| x[a].distance_squared(x[b]).total_cmp(&x[c].distance_squared(x[d])))?;
         // NaN sizes (none known) drop out of the minimum.
-        let smallest = tet.iter().map(|&v| self.size[v as usize]).fold(f64::INFINITY, f64::min);
+        let largest = self.options.max_size.unwrap_or(f64::INFINITY);
+        let smallest = tet.iter().map(|&v| self.size[v as usize]).fold(largest, f64::min);
         let size_ratio = radius / (self.options.circumradius_per_size * smallest);
         let shape_ratio = radius / (self.options.radius_edge * x[i].distance(x[j]));
         let too_large = size_ratio > 1.0;
@@ -221,8 +264,10 @@ impl Refinement<'_> {
     }
 
     /// Insert a point for `bad` at the first of its candidates that is not rejected; whether
-    /// one went in.
+    /// one went in. A tetrahedron whose every candidate is rejected for a lasting reason is
+    /// given up.
     fn split(&mut self, bad: &Bad, stats: &mut RefineStats) -> bool {
+        let mut lasting = true;
         for p in self.candidates(bad) {
             match self.insert(bad, p) {
                 Ok(()) => {
@@ -230,6 +275,7 @@ impl Refinement<'_> {
                     return true;
                 }
                 Err(why) => {
+                    lasting &= why.lasting();
                     *match why {
                         Rejected::Outside => &mut stats.outside,
                         Rejected::NearBoundary => &mut stats.near_boundary,
@@ -239,6 +285,11 @@ impl Refinement<'_> {
                     } += 1
                 }
             }
+        }
+        if lasting {
+            let t = bad.tet as usize;
+            self.given_up.resize(self.given_up.len().max(t + 1), false);
+            self.given_up[t] = true;
         }
         false
     }
@@ -258,16 +309,26 @@ impl Refinement<'_> {
     fn insert(&mut self, bad: &Bad, p: DVec3) -> Result<(), Rejected> {
         let mesh = &*self.mesh;
         let start = walk(mesh, bad.tet, p).ok_or(Rejected::Outside)?;
+        let largest = self.options.max_size.unwrap_or(f64::INFINITY);
         let shortest = bad.shortest[0].distance(bad.shortest[1]);
-        let interpolated = interpolate(mesh, self.size, start, p);
-        let local = if interpolated.is_finite() { interpolated } else { shortest };
+        let interpolated = interpolate(mesh, self.size, start, p).min(largest);
+        let or_shortest = |size: f64| if size.is_finite() { size } else { shortest };
+        let local = or_shortest(interpolated);
+        let distance = |v: &u32| mesh.points[*v as usize].distance(p);
+        let near_vertex = |vertices: &[u32]| {
+            vertices.iter().map(distance).fold(f64::INFINITY, f64::min) < self.options.spacing * local
+        };
+        if near_vertex(&mesh.tet(start)) {
+            return Err(Rejected::NearVertex);
+        }
         if self.boundary.nearest_within(p, self.options.clearance * local).is_some() {
             return Err(Rejected::NearBoundary);
         }
-        let (remove, add) = star_cavity(mesh, &[start], p, &|_| false).map_err(|why| match why {
-            Skipped::Outside | Skipped::OnBoundary => Rejected::Outside,
-            Skipped::NoStar | Skipped::Duplicate => Rejected::NoCavity,
-        })?;
+        let (remove, add) =
+            star_cavity(mesh, &[start], p, &|_| false, self.options.max_cavity).map_err(|why| match why {
+                Skipped::Outside | Skipped::OnBoundary => Rejected::Outside,
+                Skipped::NoStar | Skipped::Duplicate | Skipped::LargeCavity => Rejected::NoCavity,
+            })?;
         let inside = |n: u32| remove.binary_search(&n).is_ok();
         let encroached =
             cavity_faces(mesh, remove.iter().copied(), inside).into_iter().any(|(face, _, across)| {
@@ -279,19 +340,18 @@ impl Refinement<'_> {
         let mut vertices: Vec<u32> = add.iter().flat_map(|t| [t[0], t[1], t[2]]).collect();
         vertices.sort_unstable();
         vertices.dedup();
-        let distance = |v: &u32| mesh.points[*v as usize].distance(p);
-        if vertices.iter().map(distance).fold(f64::INFINITY, f64::min) < self.options.spacing * shortest {
+        if near_vertex(&vertices) {
             return Err(Rejected::NearVertex);
         }
-        let graded = self.options.gradation.map_or(f64::INFINITY, |g| {
+        let size = self.options.gradation.map_or(interpolated, |g| {
             vertices
                 .iter()
                 .map(|v| self.size[*v as usize] + (g - 1.0) * distance(v))
-                .fold(f64::INFINITY, f64::min)
+                .fold(interpolated, f64::min)
         });
         let v = mesh.points.len() as u32;
         self.mesh.apply(&Change::replacing(remove, add, Some((v, p))));
-        self.size.push(if interpolated.is_finite() { interpolated.min(graded) } else { f64::NAN });
+        self.size.push(if size.is_finite() { size } else { f64::NAN });
         Ok(())
     }
 }
