@@ -258,12 +258,6 @@ pub struct CoreTets {
 /// from the guide's interior points (which it may still move or remove).
 pub trait CoreMesher {
     fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError>;
-
-    /// Whether the sizes of the points it adds are graded already, by the options' sizing
-    /// ([`grading`]): then one fill is the core (no graded second fill).
-    fn grades(&self) -> bool {
-        false
-    }
 }
 
 #[derive(Debug, thiserror::Error)]
@@ -425,8 +419,7 @@ pub fn fill_core_on_symmetry_plane(
 ) -> Result<(VolumeMesh, CoreStats), FillError> {
     match options.mesher {
         CoreMesherChoice::Native => {
-            let native = recover::NativeCore::graded(options.sizing.as_ref());
-            fill_core_with_symmetry(&native, layers, wall, options, symmetry)
+            fill_core_with_symmetry(&recover::NativeCore::default(), layers, wall, options, symmetry)
         }
         #[cfg(feature = "tetgen")]
         CoreMesherChoice::TetGen => {
@@ -483,7 +476,6 @@ pub fn fill_core_with_symmetry(
         SeededFill { tets, seeds_used: 0, seeds: seeds::Seeds::default(), crashes: 0, guide }
     };
     let (tets, seeds_used, graded) = match &options.sizing {
-        Some(_) if mesher.grades() => (tets, seeds_used, grading::Graded { graded: true, region_points: 0 }),
         Some(sizing) => grading::fill_graded(mesher, &boundary, tets, seeds_used, guide, sizing)?,
         None => (tets, seeds_used, grading::Graded::default()),
     };

@@ -35,8 +35,8 @@
 //!
 //! Cost: the boundary of spot's core (front, seeds' boundary, box farfield; 1351 of its edges
 //! missing from the Delaunay tetrahedralisation, mostly the farfield's and the front's
-//! diagonals) recovers in 0.3-0.5 s; the whole fill with the guide's points is 1.2-1.6 times
-//! TetGen's time with its refinement, which this does not do.
+//! diagonals) recovers in 0.3-0.5 s; with the guide's points and the refinement, the two
+//! native fills of a graded core take 2.5-3.5 times TetGen's two.
 
 mod cavity;
 mod cross;
@@ -55,7 +55,6 @@ use serde::Serialize;
 use self::cross::Target;
 use self::recovery::Recovery;
 use super::delaunay::Delaunay;
-use super::grading::CoreSizing;
 use super::improve::TetMesh;
 use super::{ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
 use crate::geometry::DVec3;
@@ -77,27 +76,9 @@ impl CoreMesher for NativeCore {
     fn fill(&self, boundary: &ClosedBoundary, guide: &CoreGuide) -> Result<CoreTets, FillError> {
         self.fill_refined(boundary, guide).map(|(core, _)| core)
     }
-
-    fn grades(&self) -> bool {
-        self.refine.gradation.is_some()
-    }
 }
 
 impl NativeCore {
-    /// The native core grading its sizes as it refines, by `sizing`'s gradation and under its
-    /// maximum size: one fill gives the graded core. Not with refinement regions (their
-    /// sizes are sampled from a first fill by the graded second fill, [`crate::fill::grading`]),
-    /// nor without `sizing`.
-    pub fn graded(sizing: Option<&CoreSizing>) -> NativeCore {
-        let Some(sizing) = sizing.filter(|s| s.regions.is_empty()) else { return NativeCore::default() };
-        let refine = refine::RefineOptions {
-            gradation: Some(sizing.gradation),
-            max_size: sizing.max_size,
-            ..Default::default()
-        };
-        NativeCore { refine }
-    }
-
     /// [`CoreMesher::fill`], and what the refinement did.
     pub fn fill_refined(
         &self,

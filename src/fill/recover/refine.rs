@@ -71,7 +71,9 @@ pub struct RefineOptions {
     pub passes: usize,
     /// When set, an added point's size is at most the size of each vertex of its cavity plus
     /// `gradation - 1` times its distance to it (sizes graded as they are made); `None`:
-    /// interpolated only.
+    /// interpolated only. The pipeline grades the sizes by a first fill instead
+    /// ([`crate::fill::grading`]): one graded fill gives a finer core than that (straight
+    /// distances are shorter than paths along edges).
     pub gradation: Option<f64>,
     /// No size above this (the user's maximum size, `[sizing] max_size`) at the corners of a
     /// tetrahedron or at an added point; `None`: no bound.
