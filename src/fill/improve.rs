@@ -22,7 +22,7 @@ use super::size_jump::height_over;
 use super::{sorted_triangle, ClosedBoundary, CoreTets, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
 use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::predicates::{orient3d, Sign};
-use crate::geometry::{triangle_area_vector, DVec3};
+use crate::geometry::{tet_circumcentre, triangle_area_vector, DVec3};
 use crate::mesh::{sorted_edge, CellKind};
 
 pub use slide::{FrontSlides, MAX_SINK};
@@ -872,7 +872,8 @@ impl TetMesh {
     /// chooses the cavity, whose cone is then checked exactly).
     fn in_circumsphere(&self, t: u32, p: DVec3) -> bool {
         let x = self.corners(self.tets[t as usize]);
-        circumcentre(x).is_some_and(|centre| (p - centre).length_squared() < (x[0] - centre).length_squared())
+        tet_circumcentre(x)
+            .is_some_and(|centre| (p - centre).length_squared() < (x[0] - centre).length_squared())
     }
 
     /// Where to insert a point for tetrahedron `t`: over each of its boundary faces the best
@@ -892,7 +893,7 @@ impl TetMesh {
             points.push((best_apex(a, c, b).0, Placement::Best));
             points.extend(self.matched_apex(t, face).map(|p| (p, Placement::AsGiven)));
         }
-        points.extend(circumcentre(self.corners(self.tets[t as usize])).map(|p| (p, Placement::Best)));
+        points.extend(tet_circumcentre(self.corners(self.tets[t as usize])).map(|p| (p, Placement::Best)));
         points.push((self.centroid(t), Placement::Best));
         points
     }
@@ -1178,16 +1179,6 @@ pub(crate) fn best_polygon_triangulation(
         stack.push((k, j));
     }
     Some(triangles)
-}
-
-/// The centre of the sphere through the corners of a tetrahedron (none when it is flat).
-fn circumcentre([a, b, c, d]: [DVec3; 4]) -> Option<DVec3> {
-    let (u, v, w) = (b - a, c - a, d - a);
-    let denominator = 2.0 * u.dot(v.cross(w));
-    let centre =
-        (u.length_squared() * v.cross(w) + v.length_squared() * w.cross(u) + w.length_squared() * u.cross(v))
-            / denominator;
-    (denominator != 0.0 && centre.is_finite()).then_some(a + centre)
 }
 
 /// Where an inserted point goes.

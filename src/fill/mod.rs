@@ -43,6 +43,14 @@ pub const DEFAULT_FARFIELD_FACTOR: f64 = 20.0;
 /// Default edge length of the farfield triangles, in body sizes.
 pub const DEFAULT_FARFIELD_CELL: f64 = 2.0;
 
+/// The meshers bound circumradii (TetGen's `-m`, the native refinement), the guide gives edge
+/// lengths: the largest circumradius per size. A regular tetrahedron has sqrt(6)/4 = 0.61, but
+/// the first core tetrahedra stand on a front triangle with a seed above one corner, like the
+/// corner of a cube (circumradius 0.87 of its edge), and the front's edges vary around their
+/// mean: at 0.61 TetGen split most of them and put its own points at half the layer height
+/// (fandisk: 21% of the first core cells within [1/r, r] of the last layer, 66% at 1.2).
+pub const CIRCUMRADIUS_PER_SIZE: f64 = 1.2;
+
 /// Markers of the [`ClosedBoundary`] triangles built by [`fill_core`].
 pub const MARKER_FRONT: u32 = 1;
 pub const MARKER_WALL: u32 = 2;
@@ -411,7 +419,7 @@ pub fn fill_core_on_symmetry_plane(
 ) -> Result<(VolumeMesh, CoreStats), FillError> {
     match options.mesher {
         CoreMesherChoice::Native => {
-            fill_core_with_symmetry(&recover::NativeCore, layers, wall, options, symmetry)
+            fill_core_with_symmetry(&recover::NativeCore::default(), layers, wall, options, symmetry)
         }
         #[cfg(feature = "tetgen")]
         CoreMesherChoice::TetGen => {

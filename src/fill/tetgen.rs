@@ -25,17 +25,9 @@ use std::ffi::{c_char, c_int, CString};
 use std::sync::Mutex;
 
 use super::isolate::{in_child, ChildEnd};
-use super::{ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError};
+use super::{ClosedBoundary, CoreGuide, CoreMesher, CoreTets, FillError, CIRCUMRADIUS_PER_SIZE};
 use crate::geometry::predicates::{orient3d, Sign};
 use crate::geometry::DVec3;
-
-/// TetGen's `-m` bounds circumradii, the guide gives edge lengths: the largest circumradius
-/// per size. A regular tetrahedron has sqrt(6)/4 = 0.61, but the first core tetrahedra stand on
-/// a front triangle with a seed above one corner, like the corner of a cube (circumradius 0.87
-/// of its edge), and the front's edges vary around their mean: at 0.61 TetGen split most of
-/// them and put its own points at half the layer height (fandisk: 21% of the first core cells
-/// within [1/r, r] of the last layer, 66% at 1.2).
-const CIRCUMRADIUS_PER_SIZE: f64 = 1.2;
 
 /// TetGen with its quality and optimisation settings.
 #[derive(Clone, Debug, PartialEq)]

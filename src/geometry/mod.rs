@@ -94,3 +94,23 @@ pub fn signed_turn_deg(first: [DVec3; 3], second: [DVec3; 3], far: DVec3) -> f64
 pub fn tet_signed_volume(a: DVec3, b: DVec3, c: DVec3, d: DVec3) -> f64 {
     (b - a).cross(c - a).dot(d - a) / 6.0
 }
+
+/// The centre of the sphere through the corners of a tetrahedron (none when it is flat).
+pub fn tet_circumcentre([a, b, c, d]: [DVec3; 4]) -> Option<DVec3> {
+    let (u, v, w) = (b - a, c - a, d - a);
+    let denominator = 2.0 * u.dot(v.cross(w));
+    let centre =
+        (u.length_squared() * v.cross(w) + v.length_squared() * w.cross(u) + w.length_squared() * u.cross(v))
+            / denominator;
+    (denominator != 0.0 && centre.is_finite()).then_some(a + centre)
+}
+
+/// The centre of the circle through the corners of a triangle, in its plane (none when it has
+/// no area).
+pub fn triangle_circumcentre(a: DVec3, b: DVec3, c: DVec3) -> Option<DVec3> {
+    let (u, v) = (b - a, c - a);
+    let normal = u.cross(v);
+    let centre = (u.length_squared() * v.cross(normal) + v.length_squared() * normal.cross(u))
+        / (2.0 * normal.length_squared());
+    centre.is_finite().then_some(a + centre)
+}

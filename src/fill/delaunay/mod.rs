@@ -44,10 +44,8 @@
 //! underflows: the insphere determinant is of degree 5 in the coordinates relative to the
 //! tested point, so those must stay between about 1e-60 and 1e60 in magnitude.
 //!
-//! Left for the next steps of the core mesher: recovery of the boundary triangles (flips and
-//! Steiner points off the front, keeping every front triangle as a face), removal of the
-//! tetrahedra outside the region, Delaunay refinement to the graded size field, and local
-//! re-meshing of a cavity.
+//! The rest of the native core mesher (boundary recovery, exterior removal, refinement to the
+//! sizes) is [`crate::fill::recover`]; local re-meshing of a cavity is left.
 
 mod insert;
 mod sort;

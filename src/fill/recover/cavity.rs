@@ -223,7 +223,8 @@ impl Recovery {
             if triangles.iter().any(|t| on_triangle(p, t.map(x))) {
                 continue;
             }
-            let Ok((remove, add)) = super::insert::star_cavity(&self.mesh, &[hint], p, &wall) else {
+            let Ok((remove, add)) = super::insert::star_cavity(&self.mesh, &[hint], p, &wall, usize::MAX)
+            else {
                 continue;
             };
             if self.keeps_boundary(&remove, &add) {

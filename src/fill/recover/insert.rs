@@ -21,6 +21,8 @@ pub(super) enum Skipped {
     NoStar,
     /// At a vertex.
     Duplicate,
+    /// Its cavity would take more tetrahedra than allowed.
+    LargeCavity,
 }
 
 /// Steps at most of a walk before the search.
@@ -43,7 +45,7 @@ fn locate(mesh: &TetMesh, hints: &[u32], p: DVec3) -> Option<u32> {
 }
 
 /// The visibility walk of [`locate`] from `hint`; `None` when it leaves the region.
-fn walk(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
+pub(super) fn walk(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
     let beyond = |t: u32, i: usize| {
         let f = inward_faces(mesh.tet(t))[i];
         let [a, b, c] = f.map(|v| mesh.points[v as usize]);
@@ -74,7 +76,7 @@ fn walk(mesh: &TetMesh, hint: u32, p: DVec3) -> Option<u32> {
 /// Insert `p` (strictly inside the region), locating it from the tetrahedra `hints`; the new
 /// point's index.
 pub(super) fn insert_point(mesh: &mut TetMesh, hints: &[u32], p: DVec3) -> Result<u32, Skipped> {
-    let (remove, add) = star_cavity(mesh, hints, p, &|_| false)?;
+    let (remove, add) = star_cavity(mesh, hints, p, &|_| false, usize::MAX)?;
     let v = mesh.points.len() as u32;
     mesh.apply(&Change::replacing(remove, add, Some((v, p))));
     Ok(v)
@@ -82,12 +84,15 @@ pub(super) fn insert_point(mesh: &mut TetMesh, hints: &[u32], p: DVec3) -> Resul
 
 /// The tetrahedra to replace to insert `p` (located from `hints`), and the cone from the new
 /// point (the next point index) replacing them; the cavity does not cross the faces without
-/// a tetrahedron across nor the `wall` faces, and `p` must be strictly off them.
+/// a tetrahedron across nor the `wall` faces, and `p` must be strictly off them. A cavity
+/// growing past `max_tets` tetrahedra is given up (its shrinking to a star costs their
+/// square).
 pub(super) fn star_cavity(
     mesh: &TetMesh,
     hints: &[u32],
     p: DVec3,
     wall: &dyn Fn(&[u32; 3]) -> bool,
+    max_tets: usize,
 ) -> Result<(Vec<u32>, Vec<[u32; 4]>), Skipped> {
     let start = locate(mesh, hints, p).ok_or(Skipped::Outside)?;
     let tet = mesh.tet(start);
@@ -113,35 +118,40 @@ pub(super) fn star_cavity(
                     cavity.insert(n);
                     stack.push(n);
                 }
+                if cavity.len() > max_tets {
+                    return Err(Skipped::LargeCavity);
+                }
             }
         }
     }
     loop {
         let faces = cavity_faces(mesh, &cavity);
-        // A face not seen from `p`: its tetrahedron leaves (the first holds `p`: a face of it
-        // that `p` is on has a tetrahedron holding `p` across, in the cavity, unless it is a
-        // boundary triangle).
+        // The tetrahedra with a face not seen from `p` leave, all at once (one at a time costs
+        // the square of a large cavity). The first holds `p`: a face of it that `p` is on has
+        // a tetrahedron holding `p` across, in the cavity, unless it is a boundary triangle.
         let seen = |f: &[u32; 3]| orient3d(x(f[0]), x(f[1]), x(f[2]), p) == Sign::Positive;
-        match faces.iter().find(|(f, _)| !seen(f)) {
-            // Only on a face of the first tetrahedron: `p` is on the boundary.
-            Some(&(_, t)) if t == start => return Err(Skipped::OnBoundary),
-            Some(&(_, t)) => {
-                cavity.remove(&t);
-                keep_connected(mesh, &mut cavity, start);
-                continue;
+        let unseen: BTreeSet<u32> = faces.iter().filter(|(f, _)| !seen(f)).map(|&(_, t)| t).collect();
+        if !unseen.is_empty() {
+            if unseen.len() == 1 && unseen.contains(&start) {
+                // Only on a face of the first tetrahedron: `p` is on the boundary.
+                return Err(Skipped::OnBoundary);
             }
-            None => {}
+            cavity.retain(|t| *t == start || !unseen.contains(t));
+            keep_connected(mesh, &mut cavity, start);
+            continue;
         }
         let v = mesh.points.len() as u32;
         let add: Vec<[u32; 4]> = faces.iter().map(|(f, _)| [f[0], f[1], f[2], v]).collect();
         let kept: HashSet<u32> = add.iter().flatten().copied().collect();
-        let lost = cavity.iter().flat_map(|&t| mesh.tet(t)).find(|u| !kept.contains(u));
-        if let Some(u) = lost {
-            // A vertex inside the cavity: a tetrahedron at it leaves.
-            let Some(&t) = cavity.iter().find(|&&t| t != start && mesh.tet(t).contains(&u)) else {
+        let lost: HashSet<u32> =
+            cavity.iter().flat_map(|&t| mesh.tet(t)).filter(|u| !kept.contains(u)).collect();
+        if !lost.is_empty() {
+            // Vertices inside the cavity: the tetrahedra at them leave.
+            let before = cavity.len();
+            cavity.retain(|&t| t == start || !mesh.tet(t).iter().any(|u| lost.contains(u)));
+            if cavity.len() == before {
                 return Err(Skipped::NoStar);
-            };
-            cavity.remove(&t);
+            }
             keep_connected(mesh, &mut cavity, start);
             continue;
         }

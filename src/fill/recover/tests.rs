@@ -10,7 +10,7 @@ use crate::surface::{shapes, Surface};
 
 /// The region inside the closed outward surfaces `outer` (reversed: its normals into the
 /// region) and outside the `holes`.
-fn region(outer: &Surface, holes: &[Surface]) -> ClosedBoundary {
+pub(super) fn region(outer: &Surface, holes: &[Surface]) -> ClosedBoundary {
     let mut boundary = ClosedBoundary::default();
     for (k, s) in std::iter::once(outer).chain(holes).enumerate() {
         let offset = boundary.points.len() as u32;
@@ -37,7 +37,7 @@ fn moved(mut s: Surface, by: DVec3) -> Surface {
 /// every boundary triangle a face of exactly one tetrahedron on its inner side
 /// ([`merge::check_boundary_kept`]), every other face shared by two, no added point on the
 /// boundary, and the volume enclosed.
-fn check(boundary: &ClosedBoundary, core: &CoreTets) {
+pub(super) fn check(boundary: &ClosedBoundary, core: &CoreTets) {
     merge::check_boundary_kept(boundary, core).unwrap();
     let mut uses: HashMap<[u32; 3], usize> = HashMap::new();
     for &tet in &core.tets {
@@ -68,7 +68,7 @@ fn fill_and_check(boundary: &ClosedBoundary, interior: Vec<DVec3>) -> RecoverySt
     let (_, stats) = recover_region(boundary).unwrap();
     eprintln!("{} triangles: {stats:?}", boundary.triangles.len());
     let guide = CoreGuide { interior, ..Default::default() };
-    let core = NativeCore.fill(boundary, &guide).unwrap();
+    let core = NativeCore::default().fill(boundary, &guide).unwrap();
     check(boundary, &core);
     stats
 }
@@ -88,7 +88,7 @@ fn cube_with_interior_points() {
         DVec3::new(0.5, 0.5, 0.0),
     ];
     let boundary = region(&shapes::cuboid(DVec3::ONE, 2), &[]);
-    let core = NativeCore.fill(&boundary, &CoreGuide { interior, ..Default::default() }).unwrap();
+    let core = NativeCore::default().fill(&boundary, &CoreGuide { interior, ..Default::default() }).unwrap();
     check(&boundary, &core);
     // The two inside went in; the one outside and the one on the boundary did not.
     assert_eq!(core.points.len(), boundary.points.len() + 2);
