@@ -864,7 +864,9 @@ pub(super) fn merge_into_crease(
         for &(r, crease_top, middle) in &meetings {
             plan.proposed[r as usize] = columns.slide[r as usize].project(crease_top.lerp(middle, part));
         }
-        if !crosses(plan) && invalid_cells(plan, &group) == 0 {
+        let (crossing, invalid) = (crosses(plan), invalid_cells(plan, &group));
+        tracing::trace!(?pairs, part, crossing, invalid, "a V's merge into its crease tried");
+        if !crossing && invalid == 0 {
             redirect_creases(plan, columns, &meeting_at);
             tracing::debug!(
                 ?pairs,
@@ -1071,7 +1073,9 @@ pub(super) fn retreat_fans(
         }
     }
     let group = around(plan);
-    if !merged || invalid_cells(plan, &group) > before {
+    let after = invalid_cells(plan, &group);
+    tracing::trace!(f, g, merged, before, after, "fans' retreat tried");
+    if !merged || after > before {
         *plan = saved;
         return None;
     }
