@@ -962,8 +962,9 @@ pub(super) fn crease_groups(
 }
 
 /// The ends of the edge that crossing faces `(f, g)` share (after the merges), each with the
-/// columns of the V beside it on both faces; `None` where they share no edge, an empty list
-/// where no end has V columns on both sides.
+/// columns of the V beside it on both faces; `None` where they share no edge (unless
+/// `or_corner`: then their one shared corner, [`vertex_meeting`]), an empty list where no end
+/// has V columns on both sides.
 fn crease_meetings(
     plan: &SlabPlan,
     front: &Front,
@@ -1013,7 +1014,7 @@ fn vertex_meeting(plan: &SlabPlan, pf: &Polygon, pg: &Polygon) -> Option<(u32, V
     let shared: Vec<u32> = pf.nodes().iter().copied().filter(|c| pg.nodes().contains(c)).collect();
     let &[r] = shared.as_slice() else { return None };
     let top = |c: u32| plan.proposed[c as usize];
-    let centre = |p: &Polygon| p.nodes().iter().map(|&c| top(c)).sum::<DVec3>() / p.nodes().len() as f64;
+    let centre = |p: &Polygon| top_centre(plan, p);
     let nearest_beside = |p: &Polygon, other: DVec3| {
         let n = p.nodes();
         let i = n.iter().position(|&c| c == r)?;
@@ -1022,6 +1023,11 @@ fn vertex_meeting(plan: &SlabPlan, pf: &Polygon, pg: &Polygon) -> Option<(u32, V
             .min_by(|&a, &b| top(a).distance_squared(other).total_cmp(&top(b).distance_squared(other)))
     };
     Some((r, vec![nearest_beside(pf, centre(pg))?, nearest_beside(pg, centre(pf))?]))
+}
+
+/// The mean of the proposed tops of polygon `p`'s columns.
+fn top_centre(plan: &SlabPlan, p: &Polygon) -> DVec3 {
+    p.nodes().iter().map(|&c| plan.proposed[c as usize]).sum::<DVec3>() / p.nodes().len() as f64
 }
 
 /// Where two faces whose tops cross are fan strips of a convex ridge or corner (or one of them
@@ -1042,7 +1048,7 @@ pub(super) fn retreat_fans(
 ) -> Option<Vec<u32>> {
     let (pf, pg) = (plan.merges.resolved_face(front, f)?, plan.merges.resolved_face(front, g)?);
     let top = |c: u32| plan.proposed[c as usize];
-    let centre = |p: &Polygon| p.nodes().iter().map(|&c| top(c)).sum::<DVec3>() / p.nodes().len() as f64;
+    let centre = |p: &Polygon| top_centre(plan, p);
     let mut retreats: Vec<(u32, u32)> = Vec::new();
     for (p, other) in [(&pf, centre(&pg)), (&pg, centre(&pf))] {
         let n = p.nodes();
