@@ -39,7 +39,7 @@ pub struct Settings {
     /// Largest angle (degrees) between neighbouring normals of a fan at a convex ridge.
     #[arg(long, allow_negative_numbers = true)]
     pub fan_angle: Option<f64>,
-    /// The core mesher: "tetgen" (default) or "native" (boundary recovery, no refinement yet).
+    /// The core mesher: "tetgen" (default) or "native" (Delaunay, boundary recovery and refinement).
     #[arg(long, value_name = "MESHER")]
     pub core_mesher: Option<crate::config::CoreMesherChoice>,
     /// Write only the layers (no core tetrahedra).

@@ -28,7 +28,7 @@
 //! radius = 1.1
 //! size = 0.02
 //! [core]
-//! mesher = "tetgen"            # or "native" (boundary recovery, no refinement yet; --core-mesher)
+//! mesher = "tetgen"            # or "native" (Delaunay, boundary recovery, refinement; --core-mesher)
 //! [flow_conditions]            # for yplus: Re on a reference length (heights in its units)
 //! reynolds = 14.6e6
 //! length = 646.07

@@ -35,7 +35,9 @@ use rayon::prelude::*;
 use super::front::{Columns, Front};
 use super::march::SlabPlan;
 use super::slab::Polygon;
+use super::unfold::CAP_ANGLE;
 use crate::geometry::distance::closest_point_on_triangle;
+use crate::geometry::triangle_max_angle;
 use crate::sizing::wall::WallDistance;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
@@ -383,6 +385,13 @@ const LINE_LIKE: f64 = 0.5;
 /// beside it (equal columns meet in the middle, on the bisector of a straight ridge) gives both
 /// sides the same edge there. So do a wall edge far shorter than the layer (its face turns
 /// over in one layer) and a valley narrower than the layers (its faces squeezed flat).
+/// A triangle whose top is a cap ([`CAP_ANGLE`]) on a crease counts as flat whatever its area:
+/// where two walls' columns converge on their bisector (a post's or a wing's foot), a column
+/// about to reach it has its top nearly on the line of two that did (they carry merged
+/// columns); left so on the final front, every core tetrahedron on that cap is a sliver. Its
+/// shortest edge, the middle corner to the nearer end, is merged first: the column meets the
+/// bisector a step early. Such a cap's cell is valid, so its merge must leave every cell around
+/// valid; a cap with a fan's column is the front wrapping round a convex edge, not a crease.
 /// Returns the number of collapses.
 pub(super) fn merge_flat_tops(
     plan: &mut SlabPlan,
@@ -392,6 +401,7 @@ pub(super) fn merge_flat_tops(
     k: u32,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) -> usize {
+    let carries = super::swap::carrying_merged(columns);
     // The faces of `plan` left flat along a line, with their columns' roots.
     let flat_along_a_line = |plan: &SlabPlan, f: usize| {
         let face = plan.merges.resolved_face(front, f)?;
@@ -405,16 +415,27 @@ pub(super) fn merge_flat_tops(
         if n.len() < 3 || !moving || !in_stack {
             return None;
         }
-        if !area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP) {
+        let top = |c: u32| plan.proposed[c as usize];
+        let in_fan = |c: u32| {
+            let mut mates = Vec::new();
+            front.fan_mates(columns, c as usize, &mut mates);
+            !mates.is_empty()
+        };
+        let on_crease = |c: u32| carries[c as usize] || plan.merges.group(c).nth(1).is_some();
+        let cap = n.len() == 3
+            && triangle_max_angle(top(n[0]), top(n[1]), top(n[2])) > CAP_ANGLE
+            && !n.iter().any(|&c| in_fan(c))
+            && long_edge_ends(n, &top).iter().all(|&c| on_crease(c));
+        let flat = area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP);
+        if !cap && !flat {
             return None;
         }
-        let top = |c: u32| plan.proposed[c as usize];
         // Flat along a line, not crushed to a point (the cells' repairs see to those).
         let bottom = |c: u32| points[columns.node[c as usize] as usize];
         let longest = |at: &dyn Fn(u32) -> DVec3| {
             (0..n.len()).map(|i| at(n[i]).distance(at(n[(i + 1) % n.len()]))).fold(0.0, f64::max)
         };
-        (longest(&top) >= LINE_LIKE * longest(&bottom)).then_some(face)
+        (longest(&top) >= LINE_LIKE * longest(&bottom)).then_some((face, !flat))
     };
     // Seen for every face in parallel under the plan as it comes; once a merge changed it, face
     // by face (a merge tried and undone leaves the plan as it was).
@@ -425,7 +446,7 @@ pub(super) fn merge_flat_tops(
         if merged == 0 && !flat_at_first {
             continue;
         }
-        let Some(face) = flat_along_a_line(plan, f) else { continue };
+        let Some((face, cap_only)) = flat_along_a_line(plan, f) else { continue };
         let n = face.nodes();
         let top = |c: u32| plan.proposed[c as usize];
         let mut edges: Vec<(f64, u32, u32)> = (0..n.len())
@@ -436,8 +457,10 @@ pub(super) fn merge_flat_tops(
         edges.sort_by(|x, y| x.0.total_cmp(&y.0));
         for (_, a, b) in edges {
             let group: Vec<u32> = plan.merges.group(a).chain(plan.merges.group(b)).collect();
-            let before = invalid_cells(plan, &group);
-            if try_collapse(plan, columns, a, b, &|plan, group| invalid_cells(plan, group) <= before) {
+            // A cap is valid as it is: its merge, for the core's sake, must leave every cell
+            // around valid.
+            let allowed = if cap_only { 0 } else { invalid_cells(plan, &group) };
+            if try_collapse(plan, columns, a, b, &|plan, group| invalid_cells(plan, group) <= allowed) {
                 tracing::debug!(f, a, b, at = ?columns.base[a as usize], "flat top mended by a merge");
                 merged += 1;
                 break;
@@ -445,6 +468,17 @@ pub(super) fn merge_flat_tops(
         }
     }
     merged
+}
+
+/// The ends of the longest edge of the triangle `n` with corners at `top`.
+fn long_edge_ends(n: &[u32], top: &impl Fn(u32) -> DVec3) -> [u32; 2] {
+    let i = (0..3)
+        .max_by(|&i, &j| {
+            let length = |i: usize| top(n[i]).distance_squared(top(n[(i + 1) % 3]));
+            length(i).total_cmp(&length(j))
+        })
+        .unwrap_or(0);
+    [n[i], n[(i + 1) % 3]]
 }
 
 /// The roots of the columns next to root `c`'s group on the front, other than `c`.
@@ -1298,15 +1332,11 @@ mod tests {
     }
 
     /// A ridge along x (columns 0-4 at y = 0) between two walls of face columns (5-8 at y = 1,
-    /// 9-12 at y = -1), every column rising by 0.1; face columns 6 and 7 beside ridge column 2
-    /// merge into ridge columns 1 and 3, leaving the face (2, 7, 6) flat on the ridge.
-    #[test]
-    fn a_face_flattened_along_a_ridge_by_merges_both_ways_is_collapsed() {
-        let spec = crate::config::LayerSpec::fixed(0.01, 1.2, 10);
+    /// 9-12 at y = -1): their bottoms and the front over them.
+    fn ridge_between_walls() -> (Vec<DVec3>, Front) {
         let ridge = (0..5).map(|i| DVec3::new(i as f64, 0.0, 0.0));
         let side = |y: f64| (0..4).map(move |i| DVec3::new(i as f64 + 0.5, y, 0.0));
         let bottoms: Vec<DVec3> = ridge.chain(side(1.0)).chain(side(-1.0)).collect();
-        let columns = Columns::rising(&bottoms, Some(spec));
         let mut front = Front::default();
         for i in 0..4u32 {
             let (r, a, b) = (i, 5 + i, 9 + i);
@@ -1317,7 +1347,17 @@ mod tests {
                 front.push(&[r + 1, b, b + 1], 0, None);
             }
         }
-        front.index_columns(bottoms.len());
+        front.index_columns(bottoms.len() + 2);
+        (bottoms, front)
+    }
+
+    /// The ridge and walls of [`ridge_between_walls`], every column rising by 0.1; face columns
+    /// 6 and 7 beside ridge column 2 merge into ridge columns 1 and 3, leaving the face (2, 7, 6)
+    /// flat on the ridge.
+    #[test]
+    fn a_face_flattened_along_a_ridge_by_merges_both_ways_is_collapsed() {
+        let (bottoms, front) = ridge_between_walls();
+        let columns = Columns::rising(&bottoms, Some(crate::config::LayerSpec::fixed(0.01, 1.2, 10)));
         let mut plan = SlabPlan::moving_to(bottoms.iter().map(|&b| b + 0.1 * DVec3::Z).collect());
         plan.merges.merge(1, 6);
         plan.merges.merge(3, 7);
@@ -1332,6 +1372,34 @@ mod tests {
         let root = |c: u32| plan.merges.root(c);
         assert!(root(2) == root(1) || root(2) == root(3), "the middle ridge column merged");
         assert_eq!(plan.proposed[root(2) as usize].y, 0.0, "on the ridge's bisector");
+    }
+
+    /// The ridge and walls of [`ridge_between_walls`], every column rising by 0.1 but face
+    /// column 6, whose top comes to lie `gap` from the ridge between ridge columns 1 and 2: when
+    /// those carry merged columns (a crease), the face (1, 2, 6) is a cap at 6 whatever its area
+    /// (at a gap of 0.06, 166 degrees, the top keeps 6% of the bottom's) and is merged into the
+    /// crease; a face merely thin, or a cap off a crease, is left alone.
+    #[test]
+    fn a_face_whose_top_is_a_cap_on_a_crease_is_collapsed_and_a_thin_one_is_not() {
+        let spec = crate::config::LayerSpec::fixed(0.01, 1.2, 10);
+        let (bottoms, front) = ridge_between_walls();
+        let plain = Columns::rising(&bottoms, Some(spec));
+        // Two columns off the front, merged into ridge columns 1 and 2 in an earlier layer.
+        let mut crease = Columns::rising(&[bottoms.clone(), vec![DVec3::Z; 2]].concat(), Some(spec));
+        crease.merged_into[13] = 1;
+        crease.merged_into[14] = 2;
+        let merged = |columns: &Columns, gap: f64| {
+            let mut tops: Vec<DVec3> = (0..columns.len()).map(|c| columns.base[c] + 0.1 * DVec3::Z).collect();
+            tops[6] = DVec3::new(1.5, gap, 0.1);
+            let mut plan = SlabPlan::moving_to(tops);
+            let n = merge_flat_tops(&mut plan, &front, columns, &columns.base, 1, |_, _| 0);
+            let root = plan.merges.root(6);
+            assert!(n == 0 || root == 1 || root == 2, "the cap's middle corner joins the crease");
+            n
+        };
+        assert_eq!(merged(&crease, 0.06), 1, "a cap on the crease: 166 degrees at column 6's top");
+        assert_eq!(merged(&crease, 0.3), 0, "118 degrees: left alone");
+        assert_eq!(merged(&plain, 0.06), 0, "a cap between columns that carry none: no crease");
     }
 
     /// A corner overtaking its opposite edge while no edge of the triangle shrinks much.

@@ -319,7 +319,7 @@ fn cell_faces(cell: &SlabCell) -> Option<Vec<Polygon>> {
 }
 
 /// Whether each column carries a column merged into it in an earlier slab.
-fn carrying_merged(columns: &Columns) -> Vec<bool> {
+pub(super) fn carrying_merged(columns: &Columns) -> Vec<bool> {
     let mut carries = vec![false; columns.len()];
     for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
         carries[r as usize] = true;

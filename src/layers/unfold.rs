@@ -27,7 +27,7 @@ use crate::surface::topology::{group_by_key_with, opposite_vertex};
 use crate::surface::Surface;
 
 /// A front triangle whose largest angle is above this (degrees) is a cap...
-const CAP_ANGLE: f64 = 160.0;
+pub(super) const CAP_ANGLE: f64 = 160.0;
 /// ...and a front edge whose angle on the core's side is below this (degrees) a fold: the fill's
 /// tetrahedra at such an edge seldom all keep 10 degrees (20 here left spot 81 tetrahedra below
 /// 10 degrees, 40 leaves 59; at 60 the pulled-back tops cost the flange coverage).
