@@ -445,3 +445,14 @@ fn caps_on_a_post_foots_crease_merge_into_it() {
     let core = report.core.as_ref().expect("a core");
     assert!(core.min_dihedral >= 10.0, "core minimum dihedral {:.2} deg", core.min_dihedral);
 }
+
+/// A fin on a cylinder of the randomised family (seed 24) at the families' spec, layers only:
+/// in a transition layer the merges along the fin's root leave a cap whose pair is turned in
+/// its slab, after the slab's crossing guard tested it; the turned triangles crossed the tops
+/// beside them and the front handed to the core crossed itself (the run failed its own check).
+/// A turn that would cross the tops around it is not made.
+#[test]
+fn a_turn_in_a_merging_slab_never_crosses_the_front_around_it() {
+    let out = family_layers(Family::FinCylinder, 24);
+    common::assert_valid_for_a_solver("family fin-cylinder 24", &out.report.check);
+}

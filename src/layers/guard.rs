@@ -429,7 +429,7 @@ impl TopShape {
 
 /// Whether triangles `t` and `u` (node ids and points) meet elsewhere than in the vertices they
 /// share: see [`TopShape::crosses`].
-fn triangles_meet(t_ids: [u32; 3], t: [DVec3; 3], u_ids: [u32; 3], u: [DVec3; 3]) -> bool {
+pub(super) fn triangles_meet(t_ids: [u32; 3], t: [DVec3; 3], u_ids: [u32; 3], u: [DVec3; 3]) -> bool {
     let shared_in_u = t_ids.map(|v| u_ids.iter().position(|&w| w == v));
     match shared_in_u.iter().filter(|s| s.is_some()).count() {
         0 => triangles_intersect(t, u),

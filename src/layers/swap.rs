@@ -17,6 +17,7 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{Columns, Front, NOT_MERGED};
+use super::guard::triangles_meet;
 use super::march::SlabPlan;
 use super::slab::{self, cell_from_faces, Polygon, SlabCell};
 use super::split::Splits;
@@ -272,7 +273,7 @@ pub(super) fn turn_merged_tops(
         let Some(cell) = turned_cell(&cells[f].1, &cells[g].1, turn.columns.map(|c| top[c as usize])) else {
             continue;
         };
-        if !is_valid(&cell) {
+        if !is_valid(&cell) || crosses_tops_around(front, plan, top, points, &turn) {
             continue;
         }
         cells[f].1 = cell;
@@ -285,6 +286,39 @@ pub(super) fn turn_merged_tops(
         turns.push(turn);
     }
     turns
+}
+
+/// Whether a turned pair's new top triangles cross the tops of the faces around its columns:
+/// the slab's crossing guard tested the pair before it turned.
+fn crosses_tops_around(
+    front: &Front,
+    plan: &SlabPlan,
+    top: &[u32],
+    points: &[DVec3],
+    turn: &MergedTurn,
+) -> bool {
+    let merges = &plan.merges;
+    let [a, b, c, d] = turn.columns;
+    let node = |c: u32| top[merges.root(c) as usize];
+    let triangle = |t: [u32; 3]| (t.map(node), t.map(|c| points[node(c) as usize]));
+    let turned = [[c, a, d], [d, b, c]].map(triangle);
+    let mut around: Vec<usize> = turn
+        .columns
+        .iter()
+        .flat_map(|&x| merges.group(x).flat_map(|y| front.faces_of(y)))
+        .filter(|g| !turn.faces.contains(g))
+        .collect();
+    around.sort_unstable();
+    around.dedup();
+    around.into_iter().any(|g| {
+        let roots: Vec<u32> = front.face_columns(g).iter().map(|&x| merges.root(x)).collect();
+        let Some(polygon) = Polygon::dedup(&roots) else { return false };
+        let n = polygon.nodes();
+        (1..n.len() - 1).any(|i| {
+            let (ids, at) = triangle([n[0], n[i], n[i + 1]]);
+            turned.iter().any(|&(t_ids, t)| triangles_meet(t_ids, t, ids, at))
+        })
+    })
 }
 
 /// The union of the cells `first` and `second` under the tops `(a, b, c)` and `(b, a, d)` with
