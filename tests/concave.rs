@@ -319,6 +319,15 @@ fn family_layers(family: Family, seed: u64) -> MeshOutput {
     family_run(family, seed, false)
 }
 
+/// The layers alone of a body of the randomised family ([`family_layers`]) pass the solver check
+/// and keep at least `share` of the wall vertices near concave ridges with their full stack.
+fn assert_family_layers_keep(family: Family, seed: u64, share: f64) {
+    let name = format!("family {} {seed}", family.name());
+    let out = family_layers(family, seed);
+    common::assert_valid_for_a_solver(&name, &out.report.check);
+    assert_near_concave(&name, &out.report.layers, share);
+}
+
 /// A body of the randomised families at their spec (10 layers from 1e-3 of its diagonal,
 /// growth 1.2, transition layers), with its core or layers only.
 fn family_run(family: Family, seed: u64, core: bool) -> MeshOutput {
@@ -350,9 +359,7 @@ fn tangential_collapses_never_cost_a_groove_its_layers() {
 /// The V's columns merge into the crease instead.
 #[test]
 fn lip_fans_meeting_over_a_filled_groove_merge_into_its_crease() {
-    let out = family_layers(Family::Grooves, 15);
-    common::assert_valid_for_a_solver("family groove 15", &out.report.check);
-    assert_near_concave("family groove 15", &out.report.layers, 0.7);
+    assert_family_layers_keep(Family::Grooves, 15, 0.7);
 }
 
 /// A groove of the randomised family (seed 11: 45 degrees, its mouth narrower than the layers
@@ -363,9 +370,7 @@ fn lip_fans_meeting_over_a_filled_groove_merge_into_its_crease() {
 /// along its crease at once.
 #[test]
 fn a_v_closing_along_a_groove_closes_at_once() {
-    let out = family_layers(Family::Grooves, 11);
-    common::assert_valid_for_a_solver("family groove 11", &out.report.check);
-    assert_near_concave("family groove 11", &out.report.layers, 0.8);
+    assert_family_layers_keep(Family::Grooves, 11, 0.8);
 }
 
 /// A groove of the randomised family (seed 0: 30 degrees, oblique to the block) at the
@@ -375,9 +380,7 @@ fn a_v_closing_along_a_groove_closes_at_once() {
 /// stopping both left 70.8% of the vertices near the bottom with their full stack.
 #[test]
 fn two_triangles_crossing_at_a_bisector_column_meet_there() {
-    let out = family_layers(Family::Grooves, 0);
-    common::assert_valid_for_a_solver("family groove 0", &out.report.check);
-    assert_near_concave("family groove 0", &out.report.layers, 0.8);
+    assert_family_layers_keep(Family::Grooves, 0, 0.8);
 }
 
 /// A wing on a plate of the randomised family (seed 0: its trailing edge leans over the plate
@@ -388,9 +391,7 @@ fn two_triangles_crossing_at_a_bisector_column_meet_there() {
 /// stack.
 #[test]
 fn a_trailing_edge_fan_over_the_plate_retreats_where_the_plate_front_meets_it() {
-    let out = family_layers(Family::WingPlate, 0);
-    common::assert_valid_for_a_solver("family wing-plate 0", &out.report.check);
-    assert_near_concave("family wing-plate 0", &out.report.layers, 0.78);
+    assert_family_layers_keep(Family::WingPlate, 0, 0.78);
 }
 
 /// A wing on a plate of the randomised family (seed 2) at the families' spec, layers only: where

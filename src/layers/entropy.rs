@@ -1347,6 +1347,7 @@ mod tests {
                 front.push(&[r + 1, b, b + 1], 0, None);
             }
         }
+        // Indexed for two more columns, off the front (merged ones in a test).
         front.index_columns(bottoms.len() + 2);
         (bottoms, front)
     }

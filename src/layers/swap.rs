@@ -199,9 +199,11 @@ pub(super) struct MergedTurn {
 /// after the last slab never. `cells[f]` is the cell over face `f` with the survivors' tops
 /// `top`; a turned pair's two cells become one polyhedron with the new top diagonal (its other
 /// faces are the two cells' faces, so the slab stays conforming), split from its centre, and
-/// the turn is made only when that cell is valid by `is_valid`. As in [`propose`]: faces of one
-/// patch, no fan's column, no split or swap of their own (`reshaped_otherwise`), poor and
-/// gaining by the turn, the worst first, each survivor in one turn at most.
+/// the turn is made only when that cell is valid by `is_valid` and its new top triangles cross
+/// none of the tops around ([`crosses_tops_around`]: the slab's crossing guard tested the pair
+/// before the turn). As in [`propose`]: faces of one patch, no fan's column, no split or swap
+/// of their own (`reshaped_otherwise`), poor and gaining by the turn, the worst first, each
+/// survivor in one turn at most.
 #[allow(clippy::too_many_arguments)]
 pub(super) fn turn_merged_tops(
     front: &Front,
@@ -297,22 +299,21 @@ fn crosses_tops_around(
     points: &[DVec3],
     turn: &MergedTurn,
 ) -> bool {
-    let merges = &plan.merges;
-    let [a, b, c, d] = turn.columns;
-    let node = |c: u32| top[merges.root(c) as usize];
-    let triangle = |t: [u32; 3]| (t.map(node), t.map(|c| points[node(c) as usize]));
+    // In top nodes: a merged column's top is its root's.
+    let [a, b, c, d] = turn.columns.map(|x| top[x as usize]);
+    let triangle = |t: [u32; 3]| (t, t.map(|n| points[n as usize]));
     let turned = [[c, a, d], [d, b, c]].map(triangle);
     let mut around: Vec<usize> = turn
         .columns
         .iter()
-        .flat_map(|&x| merges.group(x).flat_map(|y| front.faces_of(y)))
+        .flat_map(|&x| plan.merges.group(x).flat_map(|y| front.faces_of(y)))
         .filter(|g| !turn.faces.contains(g))
         .collect();
     around.sort_unstable();
     around.dedup();
     around.into_iter().any(|g| {
-        let roots: Vec<u32> = front.face_columns(g).iter().map(|&x| merges.root(x)).collect();
-        let Some(polygon) = Polygon::dedup(&roots) else { return false };
+        let nodes: Vec<u32> = front.face_columns(g).iter().map(|&x| top[x as usize]).collect();
+        let Some(polygon) = Polygon::dedup(&nodes) else { return false };
         let n = polygon.nodes();
         (1..n.len() - 1).any(|i| {
             let (ids, at) = triangle([n[0], n[i], n[i + 1]]);
