@@ -14,7 +14,7 @@
 
 use super::entropy::neighbour_roots;
 use super::front::{Columns, Front};
-use super::march::SlabPlan;
+use super::slab_plan::SlabPlan;
 use crate::geometry::DVec3;
 
 /// How far a column turns to its neighbours' mean direction, tried in order (the least bend

@@ -19,7 +19,7 @@ use rayon::prelude::*;
 
 use super::entropy;
 use super::front::{Columns, Front};
-use super::march::SlabPlan;
+use super::slab_plan::SlabPlan;
 use super::split::EdgeSizes;
 
 /// A front edge shorter than this against the collapse sizes is collapsed.

@@ -33,8 +33,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{Columns, Front};
-use super::march::SlabPlan;
 use super::slab::Polygon;
+use super::slab_plan::SlabPlan;
 use super::unfold::CAP_ANGLE;
 use crate::geometry::distance::closest_point_on_triangle;
 use crate::geometry::triangle_max_angle;

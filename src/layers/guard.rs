@@ -14,8 +14,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{Columns, Front};
-use super::march::{Reshape, SlabPlan};
 use super::slab::Polygon;
+use super::slab_plan::{Reshape, SlabPlan};
 use super::split::{self, NONE};
 use crate::geometry::grid::overlapping_pairs_where;
 use crate::geometry::intersect::{folds_over_shared_edge, meet_beyond_shared_vertex, triangles_intersect};

@@ -17,8 +17,9 @@ use super::entropy::VertexWalls;
 use super::front::{Columns, Front, NOT_MERGED};
 use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
-use super::split::{self, Adapt, Sizes, Splits, NONE};
-use super::swap::{self, SwapRole, Swaps};
+use super::slab_plan::{Reshape, SlabPlan};
+use super::split::{self, Adapt, Sizes, NONE};
+use super::swap::{self, SwapRole};
 use super::{bend, coarsen, entropy};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -153,107 +154,6 @@ fn split_pieces(
     })
 }
 
-/// The decisions for one slab: which columns move, where to, and which merge.
-#[derive(Clone)]
-pub(super) struct SlabPlan {
-    pub moving: Vec<bool>,
-    pub proposed: Vec<DVec3>,
-    pub merges: Merges,
-    /// New direction and scale of survivors placed between the two columns they merged.
-    pub redirected: Vec<(u32, DVec3, f64)>,
-    /// Merges made, entropy and tangential.
-    pub collapses: usize,
-    /// Of those, the tangential collapses of short edges ([`super::coarsen`]), as the pairs of
-    /// columns `(a, b)`, `a < b`, that were their ends.
-    pub coarsened: Vec<(u32, u32)>,
-    /// Of those, the collapses of faces left flat along a line ([`entropy::merge_flat_tops`]).
-    pub flat_tops: usize,
-    /// Columns bent to mend an invalid cell ([`bend::bend_to_mend`]).
-    pub bends: usize,
-    /// Columns tipped to mend an invalid cell ([`bend::nudge_to_mend`]).
-    pub tips: usize,
-    /// Columns stopped in their transition layers at crushed edges ([`stop_crushed_transition`]).
-    pub crushed_stops: usize,
-    /// Columns stopped because the new front crossed itself ([`stop_to_uncross`]).
-    pub uncrossed: Vec<u32>,
-}
-
-impl SlabPlan {
-    /// A plan moving the columns marked `moving` to their `proposed` tops, nothing merged yet.
-    fn new(moving: Vec<bool>, proposed: Vec<DVec3>) -> SlabPlan {
-        let merges = Merges::new(moving.len());
-        SlabPlan {
-            moving,
-            proposed,
-            merges,
-            redirected: Vec::new(),
-            collapses: 0,
-            coarsened: Vec::new(),
-            flat_tops: 0,
-            bends: 0,
-            tips: 0,
-            crushed_stops: 0,
-            uncrossed: Vec::new(),
-        }
-    }
-
-    /// A plan moving every column to its `proposed` top.
-    #[cfg(test)]
-    pub(super) fn moving_to(proposed: Vec<DVec3>) -> SlabPlan {
-        SlabPlan::new(vec![true; proposed.len()], proposed)
-    }
-
-    /// The top node of column `c` in the proposal's numbering.
-    fn top(&self, c: u32, columns: &Columns, committed: u32) -> u32 {
-        let r = self.merges.root(c);
-        if self.moving[r as usize] {
-            committed + r
-        } else {
-            columns.node[c as usize]
-        }
-    }
-
-    /// Stop the groups of those of `columns` still moving ([`SlabPlan::stop`]); returns the
-    /// columns whose cells change.
-    fn stop_all(&mut self, columns: impl IntoIterator<Item = u32>) -> Vec<u32> {
-        let mut changed = Vec::new();
-        for c in columns {
-            if self.moving[self.merges.root(c) as usize] {
-                changed.extend(self.stop(c));
-            }
-        }
-        changed
-    }
-
-    /// Stop the columns `cols` where they are, each taken out of the group it merged into (whose
-    /// root marches on; one that is a root stops with its group, [`SlabPlan::stop`]); returns
-    /// the columns whose cells change.
-    fn stop_out_of_groups(&mut self, cols: &[u32]) -> Vec<u32> {
-        let mut stopped = Vec::new();
-        for &c in cols {
-            if self.merges.detach(c) {
-                self.moving[c as usize] = false;
-                stopped.push(c);
-            } else if self.moving[c as usize] {
-                stopped.extend(self.stop(c));
-            }
-        }
-        stopped
-    }
-
-    /// Stop the group of `c`'s root: the root and every column merged into it keep their node.
-    /// Returns the columns whose cells change.
-    fn stop(&mut self, c: u32) -> Vec<u32> {
-        let r = self.merges.root(c);
-        let mut changed = self.merges.release(r);
-        changed.push(r);
-        for &m in &changed {
-            self.moving[m as usize] = false;
-        }
-        changed
-    }
-}
-
 /// Bottom node, top node (`top(c)`) and merging of every column of face `f`, and its size.
 fn face_ends(
     front: &Front,
@@ -343,40 +243,6 @@ fn cut_from(front: &Front, merges: &Merges, columns: &Columns, a: u32, b: u32) -
                 _ => b,
             }
         }
-    }
-}
-
-/// The changes of the front's topology proposed for one slab (tangential adaptivity): splits
-/// of long edges and swaps of badly shaped pairs (the collapses are merges of the plan).
-#[derive(Clone, Debug, Default)]
-pub(super) struct Reshape {
-    pub splits: Splits,
-    pub swaps: Swaps,
-    /// The tangential size at every column's proposed top (evaluated once a slab: a sizing
-    /// field's size is a search over the wall).
-    pub target: Vec<f64>,
-}
-
-impl Reshape {
-    /// Give up the swap, else the splits, of invalid face `f`; returns the faces whose cells
-    /// change (none if it had neither).
-    fn give_up(&mut self, f: usize, plan: &SlabPlan) -> Vec<usize> {
-        let swapped = self.swaps.give_up(f, plan);
-        if !swapped.is_empty() {
-            return swapped;
-        }
-        self.splits.give_up(f, plan)
-    }
-
-    /// The faces whose cells change with the columns `changed`: the faces around them, and both
-    /// faces of a swap with one of them (its face without that column turns back into a cell of
-    /// its own when the swap is no longer made).
-    fn faces_around_columns(&self, front: &Front, changed: &[u32]) -> Vec<usize> {
-        let mut faces = front.faces_around_columns(changed);
-        faces.extend(self.swaps.faces_with_columns(changed));
-        faces.sort_unstable();
-        faces.dedup();
-        faces
     }
 }
 

@@ -13,6 +13,7 @@ pub mod gap;
 pub mod guard;
 pub mod march;
 pub mod slab;
+pub mod slab_plan;
 pub mod sliding;
 pub mod smoothness;
 pub mod split;

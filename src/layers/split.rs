@@ -17,8 +17,8 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{ColumnStart, Columns, Front};
-use super::march::SlabPlan;
 use super::slab::{self, cell_from_faces, Merging, Polygon, SlabCell};
+use super::slab_plan::SlabPlan;
 use crate::sizing::SizingField;
 
 /// Whether, and to which sizes, the front's edges are split while it marches.

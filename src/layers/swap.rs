@@ -18,8 +18,8 @@ use rayon::prelude::*;
 
 use super::front::{Columns, Front, NOT_MERGED};
 use super::guard::triangles_meet;
-use super::march::SlabPlan;
 use super::slab::{self, cell_from_faces, Polygon, SlabCell};
+use super::slab_plan::SlabPlan;
 use super::split::Splits;
 use crate::geometry::triangle_min_angle;
 
