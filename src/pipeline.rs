@@ -768,8 +768,8 @@ impl std::fmt::Display for MeshReport {
                 )?;
                 writeln!(
                     f,
-                    "          {} tetrahedra below {:.0} deg: {} at a thin angle of the boundary, {} on a badly shaped boundary triangle, {} in a thin gap, {} not forced by the boundary ({} with all nodes on the boundary)",
-                    s.count, s.threshold, s.boundary_angle, s.boundary_triangle, s.thin_gap, s.not_forced, s.all_nodes_on_boundary
+                    "          {} tetrahedra below {:.0} deg: {} at a thin angle of the boundary, {} on a badly shaped boundary triangle, {} at a needle or cap of the boundary, {} in a thin gap, {} not forced by the boundary ({} with all nodes on the boundary)",
+                    s.count, s.threshold, s.boundary_angle, s.boundary_triangle, s.poor_boundary_triangle, s.thin_gap, s.not_forced, s.all_nodes_on_boundary
                 )?;
                 writeln!(f, "          min dihedral per tetrahedron (deg): {}", q.histogram)?;
                 let p = &self.peel;

@@ -22,7 +22,7 @@ use super::size_jump::height_over;
 use super::{sorted_triangle, ClosedBoundary, CoreTets, MARKER_FARFIELD, MARKER_FRONT, MARKER_WALL};
 use crate::geometry::bvh::TriangleBvh;
 use crate::geometry::predicates::{orient3d, Sign};
-use crate::geometry::{tet_circumcentre, triangle_area_vector, DVec3};
+use crate::geometry::{tet_circumcentre, triangle_area_vector, triangle_min_angle, DVec3};
 use crate::mesh::{sorted_edge, CellKind};
 
 pub use slide::{FrontSlides, MAX_SINK};
@@ -1258,6 +1258,11 @@ pub enum SliverCause {
     /// A boundary triangle of it is so badly shaped that no tetrahedron on it reaches the
     /// threshold.
     BoundaryTriangle,
+    /// A boundary triangle at one of its edges has a corner angle below the threshold: a
+    /// needle or a cap of the front (or a pyramid's face over a narrow quad). A tetrahedron on
+    /// it alone may keep the threshold, but the tetrahedra around its short edge or its long
+    /// one, which join it to the triangles beside it, inherit its angle.
+    PoorBoundaryTriangle,
     /// The region is thin there: across the boundary triangle nearest to it, the region is
     /// `w` wide, and every tetrahedron on that triangle (inradius `r`) has a dihedral angle at
     /// most about `atan(w / r)`, which is below the threshold.
@@ -1295,6 +1300,7 @@ pub struct SliverCensus {
     pub count: usize,
     pub boundary_angle: usize,
     pub boundary_triangle: usize,
+    pub poor_boundary_triangle: usize,
     pub thin_gap: usize,
     pub not_forced: usize,
     /// Of all of them, those with their four nodes on the boundary (no point to move: only a
@@ -1331,6 +1337,19 @@ fn best_apex(a: DVec3, b: DVec3, c: DVec3) -> (DVec3, f64) {
     single.best_position(&[[0, 1, 2, 3]], 3, apex)
 }
 
+/// The edges of the boundary triangles with a corner angle below `threshold` degrees.
+fn poor_triangle_edges(boundary: &ClosedBoundary, threshold: f64) -> HashSet<[u32; 2]> {
+    boundary
+        .triangles
+        .iter()
+        .filter(|t| {
+            let [a, b, c] = t.map(|v| boundary.points[v as usize]);
+            triangle_min_angle(a, b, c) < threshold
+        })
+        .flat_map(|&[a, b, c]| [sorted_edge(a, b), sorted_edge(b, c), sorted_edge(c, a)])
+        .collect()
+}
+
 /// Which boundary triangles (marker bits) every boundary point is on.
 fn node_markers(boundary: &ClosedBoundary) -> Vec<u8> {
     let mut bits = vec![0u8; boundary.points.len()];
@@ -1359,6 +1378,7 @@ impl SliverCensus {
         let bvh = TriangleBvh::new(
             boundary.triangles.iter().map(|t| t.map(|v| boundary.points[v as usize])).collect(),
         );
+        let poor_edges = poor_triangle_edges(boundary, threshold);
         let mut census = SliverCensus { threshold, count: found.len(), ..Default::default() };
         for (tet, q) in found {
             let x = corners(tet);
@@ -1383,6 +1403,9 @@ impl SliverCensus {
                 // The faces of CellKind::Tetrahedron point out of the cell: reversed, into it.
                 census.boundary_triangle += 1;
                 SliverCause::BoundaryTriangle
+            } else if TET_EDGES.iter().any(|&(i, j)| poor_edges.contains(&sorted_edge(tet[i], tet[j]))) {
+                census.poor_boundary_triangle += 1;
+                SliverCause::PoorBoundaryTriangle
             } else if gap_width.atan2(nearest_inradius).to_degrees() < threshold {
                 census.thin_gap += 1;
                 SliverCause::ThinGap

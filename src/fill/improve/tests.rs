@@ -443,3 +443,27 @@ fn an_added_point_near_a_corner_merges_into_it() {
     assert_eq!((core.points.len(), core.tets.len()), (6, 4));
     assert!(core.tets.iter().all(|t| t.contains(&0)));
 }
+
+/// The needle (a corner of about 1 degree) and the cap (a corner of about 179 degrees) give
+/// their edges; the fair triangle beside them does not.
+#[test]
+fn needles_and_caps_of_the_boundary_give_their_edges_and_a_fair_triangle_does_not() {
+    let points = vec![
+        DVec3::ZERO,
+        DVec3::new(1.0, 0.0, 0.0),
+        DVec3::new(1.0, 0.02, 0.0),
+        DVec3::new(0.5, 0.8, 0.0),
+        DVec3::new(0.5, -0.005, 0.0),
+    ];
+    let boundary = ClosedBoundary {
+        points,
+        triangles: vec![[0, 1, 2], [0, 2, 3], [1, 0, 4]],
+        markers: vec![MARKER_FRONT; 3],
+    };
+    let edges = poor_triangle_edges(&boundary, SLIVER_THRESHOLD);
+    let mut expected = vec![[0, 1], [1, 2], [0, 2], [0, 4], [1, 4]];
+    expected.sort_unstable();
+    let mut found: Vec<[u32; 2]> = edges.into_iter().collect();
+    found.sort_unstable();
+    assert_eq!(found, expected);
+}
