@@ -106,7 +106,7 @@ impl Wall {
     }
 
     fn layers(&self, adapt: Adapt) -> blmesh::layers::Layers {
-        build_layers(&self.surface, &self.topology, &self.normals, &self.spec, adapt, &[], |_, _| {})
+        build_layers(&self.surface, &self.topology, &self.normals, &self.spec, adapt, &[], &[], |_, _| {})
     }
 }
 

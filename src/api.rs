@@ -45,8 +45,8 @@ pub struct Settings {
     /// Write only the layers (no core tetrahedra).
     #[arg(long)]
     pub no_core: bool,
-    /// March again at most N times with the stacks under the core's slivers a layer lower
-    /// (default 8; 0: never).
+    /// March again at most N times to mend the core's slivers: with the tops under them pulled
+    /// back, then with their stacks a layer lower (default 8; 0: never).
     #[arg(long, value_name = "N")]
     pub peel_rounds: Option<usize>,
     /// Do not split or collapse the layers' front edges to the tangential sizes (tangential adaptivity).

@@ -306,25 +306,41 @@ pub struct PeelStats {
 
 impl LayersAndCore<'_> {
     /// March, fill the core, and while it leaves a few slivers (at most
-    /// [`PEEL_MAX_SLIVER_SHARE`] of the front's nodes), march again with the stacks under their
-    /// front nodes a layer lower: the core there had no room for a good tetrahedron (fronts
-    /// meeting head on in a crevice, a crumpled front), and one layer less gives it room. At
+    /// [`PEEL_MAX_SLIVER_SHARE`] of the front's nodes), march again with the tops under their
+    /// front nodes free to be pulled back along their last step (most stand at caps of the
+    /// front, which a pulled-back top opens, and the stacks keep their layers), and where a
+    /// sliver stays over tops freed before, with those stacks a layer lower: the core there had
+    /// no room for a good tetrahedron (fronts meeting head on in a crevice, a crumpled front),
+    /// and one layer less gives it room. At
     /// most `peel_rounds` more marches, and none after [`PEEL_PATIENCE`] rounds in a row that
     /// did not beat the best; the round with the fewest slivers (then the best worst angle) is
     /// kept.
     fn run_peeling(&self, timings: &mut Timings) -> Result<(Round, PeelStats), MeshError> {
         let mut caps = vec![u32::MAX; self.surface.points.len()];
+        let mut at_slivers = vec![false; self.surface.points.len()];
         let mut stats = PeelStats::default();
         let mut best: Option<Round> = None;
         let mut kept_caps = 0;
+        let mut marked_last: Vec<u32> = Vec::new();
         for round in 0..=self.config.peel_rounds() {
-            let this = match self.round(&caps, timings) {
+            let this = match self.round(&caps, &at_slivers, timings) {
                 Ok(this) => this,
-                // A later round that fails leaves the best so far.
+                // A later round that fails leaves the best so far; where its tops pulled back
+                // made the front unfit for the core, the best round's stacks are lowered instead.
                 Err(e) if best.is_some() => {
                     stats.failed_round =
                         Some(format!("peeling round {round} failed, an earlier one kept: {e}"));
-                    break;
+                    let best = best.as_ref().expect("a best round");
+                    if marked_last.is_empty() {
+                        break;
+                    }
+                    for v in marked_last.drain(..) {
+                        at_slivers[v as usize] = false;
+                    }
+                    if best.slivers.lower_caps(&best.layered, &mut caps) == 0 {
+                        break;
+                    }
+                    continue;
                 }
                 Err(e) => return Err(e),
             };
@@ -332,7 +348,13 @@ impl LayersAndCore<'_> {
             let front_nodes = this.layered.top_stacks.len() as f64;
             let peelable = this.slivers.tets.len() as f64 <= PEEL_MAX_SLIVER_SHARE * front_nodes;
             let capped_now = caps.iter().filter(|&&c| c != u32::MAX).count();
-            let lowered = if peelable { this.slivers.lower_caps(&this.layered, &mut caps) } else { 0 };
+            let (marked, lowered) = if peelable {
+                this.slivers.pull_back_or_lower(&this.layered, &mut at_slivers, &mut caps)
+            } else {
+                (Vec::new(), 0)
+            };
+            let lowered = lowered + marked.len();
+            marked_last = marked;
             tracing::info!(
                 round,
                 slivers = this.slivers.tets.len(),
@@ -354,7 +376,7 @@ impl LayersAndCore<'_> {
     }
 
     /// March with the stacks at most `caps` layers high (by wall vertex) and fill the core.
-    fn round(&self, caps: &[u32], timings: &mut Timings) -> Result<Round, MeshError> {
+    fn round(&self, caps: &[u32], at_slivers: &[bool], timings: &mut Timings) -> Result<Round, MeshError> {
         let surface = self.surface;
         let bar = self.progress.bar("layers");
         let (mut layered, core_wall) = self.progress.stage(timings, "layers", || {
@@ -365,6 +387,7 @@ impl LayersAndCore<'_> {
                 self.patch_spec,
                 self.adapt,
                 caps,
+                at_slivers,
                 |k, n| bar.set(k.into(), n.into()),
             );
             let core_wall = layers::sliding::close_sliding_patches(
@@ -460,6 +483,36 @@ impl SliverScore {
     /// pit). Returns how many caps were lowered. (Every front node's stack instead: spot's
     /// coverage 87.3-88.1% in 6-8 rounds over growth 1.1999 / 1.2 / 1.2001; the tallest alone:
     /// 88.5-89.7% in 4-5.)
+    /// Mark the wall vertices under each sliver's front nodes whose tops the next round may pull
+    /// back ([`layers::unfold`]: the stack keeps its layers, its last one thinner); where all of
+    /// a sliver's were marked in an earlier round and it is still there, lower their caps
+    /// ([`SliverScore::lower_caps`]). Returns the vertices marked now and how many caps were
+    /// lowered.
+    fn pull_back_or_lower(
+        &self,
+        layered: &layers::Layers,
+        at_slivers: &mut [bool],
+        caps: &mut [u32],
+    ) -> (Vec<u32>, usize) {
+        let before = at_slivers.to_vec();
+        let mut marked = Vec::new();
+        let mut again = SliverScore { tets: Vec::new(), worst: self.worst };
+        for tet in &self.tets {
+            let stacks: Vec<u32> =
+                tet.iter().filter_map(|n| layered.top_stacks.get(n).map(|s| s.0)).collect();
+            if stacks.iter().all(|&v| before[v as usize]) {
+                again.tets.push(*tet);
+            }
+            for v in stacks {
+                if !at_slivers[v as usize] {
+                    at_slivers[v as usize] = true;
+                    marked.push(v);
+                }
+            }
+        }
+        (marked, again.lower_caps(layered, caps))
+    }
+
     fn lower_caps(&self, layered: &layers::Layers, caps: &mut [u32]) -> usize {
         let mut lowered = 0;
         for tet in &self.tets {

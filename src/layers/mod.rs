@@ -82,6 +82,7 @@ pub fn build_layers(
     patch_spec: &[Option<LayerSpec>],
     adapt: Adapt,
     caps: &[u32],
+    at_slivers: &[bool],
     mut on_layer: impl FnMut(u32, u32),
 ) -> Layers {
     let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
@@ -108,7 +109,7 @@ pub fn build_layers(
         marched = start.march(&fitted, &mut on_layer);
     }
     let Marched { mut mesh, mut columns, front, sizes, stats, lowered_first_heights } = marched;
-    let unfold = unfold::unfold_front(&mut mesh, &mut columns, &front, surface, layered);
+    let unfold = unfold::unfold_front(&mut mesh, &mut columns, &front, surface, layered, at_slivers);
     let front_edges = sizes.front_edge_lengths(&mesh.points, &columns, &front);
     add_boundary(&mut mesh, surface, &front, &columns);
     let growth = patch_spec.iter().flatten().map(|s| s.growth).fold(1.0, f64::max);

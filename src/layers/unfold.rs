@@ -207,28 +207,31 @@ pub fn unfold_front(
     front: &Front,
     surface: &Surface,
     layered: impl Fn(u32) -> bool,
+    at_slivers: &[bool],
 ) -> UnfoldStats {
     let (triangles, quads) = final_front(front, columns);
     let Some(mut core_front) = CoreFront::new(mesh.points.clone(), triangles, quads) else {
         return UnfoldStats::default();
     };
     let mut stats = UnfoldStats { defects_before: core_front.defects(), ..Default::default() };
-    if stats.defects_before == 0 {
+    let at_sliver = |c: usize| at_slivers.get(columns.wall_vertex[c] as usize).copied().unwrap_or(false);
+    if stats.defects_before == 0 && !(0..columns.len()).any(at_sliver) {
         return stats;
     }
-    let tops = movable_tops(columns, &core_front);
+    let tops = movable_tops(columns, &core_front, &at_sliver);
+    let sliver_top = |v: u32| tops.get(&v).is_some_and(|&c| at_sliver(c));
     let cells = cells_at(mesh, &tops);
     let mut moved: HashMap<u32, (DVec3, f64)> = HashMap::new();
     for _ in 0..ROUNDS {
         let mut changed = false;
         for t in 0..core_front.triangles.len() as u32 {
-            if !core_front.is_defect(t) {
+            if !core_front.is_defect(t) && !core_front.triangles[t as usize].into_iter().any(sliver_top) {
                 continue;
             }
             let forces_slivers = core_front.has_fold_sharper_than(t, SLIVER_FOLD_ANGLE);
             for v in core_front.triangles[t as usize] {
                 let Some(&c) = tops.get(&v) else { continue };
-                if ends_at_full_count(columns, c) && !forces_slivers {
+                if ends_at_full_count(columns, c) && !forces_slivers && !at_sliver(c) {
                     continue;
                 }
                 if let Some(pull) = best_pull_back(&mut core_front, columns, &cells[&v], v, c) {
@@ -276,7 +279,11 @@ fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]
 /// bisector tops by 15% of the thickness): such a top may move only where it is on a fold of
 /// `front` sharper than [`SLIVER_FOLD_ANGLE`] (and [`unfold_front`] moves it only for such a
 /// fold).
-fn movable_tops(columns: &Columns, front: &CoreFront) -> HashMap<u32, usize> {
+fn movable_tops(
+    columns: &Columns,
+    front: &CoreFront,
+    at_sliver: &impl Fn(usize) -> bool,
+) -> HashMap<u32, usize> {
     let mut on_sharp_fold = std::collections::HashSet::new();
     for t in 0..front.triangles.len() as u32 {
         if front.has_fold_sharper_than(t, SLIVER_FOLD_ANGLE) {
@@ -291,7 +298,7 @@ fn movable_tops(columns: &Columns, front: &CoreFront) -> HashMap<u32, usize> {
         .into_iter()
         .filter_map(|(v, at)| match at[..] {
             [c] if columns.layers[c] > 0
-                && (!ends_at_full_count(columns, c) || on_sharp_fold.contains(&v))
+                && (!ends_at_full_count(columns, c) || on_sharp_fold.contains(&v) || at_sliver(c))
                 && columns.slide[c] == Slide::Free
                 && columns.last_step[c] > 0.0 =>
             {
@@ -492,6 +499,30 @@ mod tests {
         let mild = lifted(30.0);
         assert!((mild.core_angle([0, 1]) - 30.0).abs() < 1e-6);
         assert!(mild.is_defect(0) && !mild.has_fold_sharper_than(0, SLIVER_FOLD_ANGLE));
+    }
+
+    /// A stack at its full count keeps its top (it ends on the exact offset), but one under a
+    /// core sliver may give way.
+    #[test]
+    fn a_full_stacks_top_may_move_only_under_a_sliver() {
+        use crate::layers::front::ColumnStart;
+        let front = pair(DVec3::new(0.5, 1.0, 0.0));
+        let mut columns = Columns::default();
+        columns.push(ColumnStart {
+            base: DVec3::new(0.5, 1.0, -0.5),
+            dir: DVec3::Z,
+            scale: 1.0,
+            node: 3,
+            layers: 5,
+            wall_vertex: 7,
+            slide: Slide::Free,
+            spec: Some(crate::config::LayerSpec::fixed(0.1, 1.0, 5)),
+            last_step: 0.1,
+        });
+        assert!(ends_at_full_count(&columns, 0));
+        assert!(movable_tops(&columns, &front, &|_| false).is_empty());
+        let under_a_sliver = |c: usize| columns.wall_vertex[c] == 7;
+        assert_eq!(movable_tops(&columns, &front, &under_a_sliver), HashMap::from([(3, 0)]));
     }
 
     #[test]
