@@ -322,6 +322,7 @@ impl LayersAndCore<'_> {
         let mut best: Option<Round> = None;
         let mut kept_caps = 0;
         let mut marked_last: Vec<u32> = Vec::new();
+        let mut lowered_instead = caps.clone();
         for round in 0..=self.config.peel_rounds() {
             let this = match self.round(&caps, &at_slivers, timings) {
                 Ok(this) => this,
@@ -348,11 +349,20 @@ impl LayersAndCore<'_> {
             let front_nodes = this.layered.top_stacks.len() as f64;
             let peelable = this.slivers.tets.len() as f64 <= PEEL_MAX_SLIVER_SHARE * front_nodes;
             let capped_now = caps.iter().filter(|&&c| c != u32::MAX).count();
-            let (marked, lowered) = if peelable {
+            let (marked, mut lowered) = if peelable {
                 this.slivers.pull_back_or_lower(&this.layered, &mut at_slivers, &mut caps)
             } else {
                 (Vec::new(), 0)
             };
+            if !marked.is_empty() {
+                // The caps these slivers would have lowered, for when the pulled tops leave
+                // slivers that no more marks or caps reach.
+                lowered_instead = caps.clone();
+                this.slivers.lower_caps(&this.layered, &mut lowered_instead);
+            } else if peelable && lowered == 0 && lowered_instead != caps {
+                lowered = lowered_instead.iter().zip(&caps).filter(|(a, b)| a != b).count();
+                caps.clone_from(&lowered_instead);
+            }
             let lowered = lowered + marked.len();
             marked_last = marked;
             tracing::info!(
