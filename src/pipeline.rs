@@ -311,10 +311,9 @@ impl LayersAndCore<'_> {
     /// front, which a pulled-back top opens, and the stacks keep their layers), and where a
     /// sliver stays over tops freed before, with those stacks a layer lower: the core there had
     /// no room for a good tetrahedron (fronts meeting head on in a crevice, a crumpled front),
-    /// and one layer less gives it room. At
-    /// most `peel_rounds` more marches, and none after [`PEEL_PATIENCE`] rounds in a row that
-    /// did not beat the best; the round with the fewest slivers (then the best worst angle) is
-    /// kept.
+    /// and one layer less gives it room. At most `peel_rounds` more marches, and none after
+    /// [`PEEL_PATIENCE`] rounds in a row that did not beat the best; the round with the fewest
+    /// slivers (then the best worst angle) is kept.
     fn run_peeling(&self, timings: &mut Timings) -> Result<(Round, PeelStats), MeshError> {
         let mut caps = vec![u32::MAX; self.surface.points.len()];
         let mut at_slivers = vec![false; self.surface.points.len()];
@@ -488,11 +487,6 @@ impl SliverScore {
             || (self.tets.len() == other.tets.len() && self.worst > other.worst)
     }
 
-    /// Cap the tallest stacks under each sliver's front nodes (those that reached the most
-    /// layers) a layer under their top; a stack keeps one layer at least (none would leave a
-    /// pit). Returns how many caps were lowered. (Every front node's stack instead: spot's
-    /// coverage 87.3-88.1% in 6-8 rounds over growth 1.1999 / 1.2 / 1.2001; the tallest alone:
-    /// 88.5-89.7% in 4-5.)
     /// Mark the wall vertices under each sliver's front nodes whose tops the next round may pull
     /// back ([`layers::unfold`]: the stack keeps its layers, its last one thinner); where all of
     /// a sliver's were marked in an earlier round and it is still there, lower their caps
@@ -523,6 +517,11 @@ impl SliverScore {
         (marked, again.lower_caps(layered, caps))
     }
 
+    /// Cap the tallest stacks under each sliver's front nodes (those that reached the most
+    /// layers) a layer under their top; a stack keeps one layer at least (none would leave a
+    /// pit). Returns how many caps were lowered. (Every front node's stack instead: spot's
+    /// coverage 87.3-88.1% in 6-8 rounds over growth 1.1999 / 1.2 / 1.2001; the tallest alone:
+    /// 88.5-89.7% in 4-5.)
     fn lower_caps(&self, layered: &layers::Layers, caps: &mut [u32]) -> usize {
         let mut lowered = 0;
         for tet in &self.tets {
