@@ -705,7 +705,18 @@ fn settle_slab(
                 changed.extend(merged);
                 continue;
             }
-            let stopped = stop_to_uncross(&mut plan, front, columns, f, g);
+            // In the transition layers a stop costs no stack its full count, and stopping both
+            // faces leaves the core a plainer front than a pit one column wide.
+            let within_count = [f, g]
+                .iter()
+                .flat_map(|&h| front.face_columns(h))
+                .any(|&c| columns.full_count(c as usize).is_some_and(|n| k <= n));
+            let fewest = if within_count {
+                stop_fewest_to_uncross(&mut plan, reshape, mesh, columns, front, (f, g))
+            } else {
+                None
+            };
+            let stopped = fewest.unwrap_or_else(|| stop_to_uncross(&mut plan, front, columns, f, g));
             plan.uncrossed.extend(&stopped);
             changed.extend(stopped);
         }
@@ -1020,15 +1031,13 @@ fn face_fan_edges(front: &Front, columns: &Columns, f: usize) -> Vec<bool> {
     (0..n).map(|i| columns.is_fan_edge(cols[i] as usize, cols[(i + 1) % n] as usize)).collect()
 }
 
-/// Stop the fewest wall points that mend invalid face `f`: one root of it (with its fan mates
-/// on a fan face), or on a fan face one fan of it taken out of the groups its columns merged
-/// into ([`SlabPlan::stop_out_of_groups`]), if that leaves its cell valid and fewer invalid
-/// cells around; the one that stops the fewest wall points. `None` when no such stop does. A
-/// face whose far corner is still short of the bisector its other corners merged on needs only
-/// that corner stopped. A fan whose columns merged into different bisector columns (a fin's
-/// trailing edge 0.2 above the body: its fan is swallowed by the fin's root, its trailing
-/// edge's root and the saddle corner between them) needs only that fan stopped, where stopping
-/// a root would stop every column merged into it.
+/// Stop the fewest wall points that mend invalid face `f` ([`stop_fewest`]), if that leaves its
+/// cell valid and fewer invalid cells around. `None` when no such stop does. A face whose far
+/// corner is still short of the bisector its other corners merged on needs only that corner
+/// stopped. A fan whose columns merged into different bisector columns (a fin's trailing edge
+/// 0.2 above the body: its fan is swallowed by the fin's root, its trailing edge's root and the
+/// saddle corner between them) needs only that fan stopped, where stopping a root would stop
+/// every column merged into it.
 fn stop_fewest_columns(
     plan: &mut SlabPlan,
     reshape: &Reshape,
@@ -1037,22 +1046,62 @@ fn stop_fewest_columns(
     front: &Front,
     f: usize,
 ) -> Option<Vec<u32>> {
-    let roots = plan.merges.face_roots(front, f);
-    if roots.len() < 2 {
-        return None;
-    }
-    let fan_face = face_fan_edges(front, columns, f).contains(&true);
-    let with_mates = |c: u32| {
-        let mut group = vec![c];
-        if fan_face {
-            add_fan_mates(front, columns, &mut group);
+    stop_fewest(plan, reshape, mesh, columns, front, &[f], |trial, before, after| {
+        face_cell_is_valid(trial, reshape, mesh, columns, front, f) && after < before
+    })
+}
+
+/// Stop the fewest wall points that uncross faces `f` and `g` ([`stop_fewest`] on either face),
+/// leaving no more invalid cells around; `None` when no single stop does. Stopping both faces'
+/// columns would stop every column merged into their roots too: where a ridge's fan meets its
+/// floor's front (a wing's trailing edge at its root), that is most of the crease between them.
+/// Used while a column of the two faces is within its full count.
+fn stop_fewest_to_uncross(
+    plan: &mut SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    (f, g): (usize, usize),
+) -> Option<Vec<u32>> {
+    stop_fewest(plan, reshape, mesh, columns, front, &[f, g], |trial, before, after| {
+        after <= before && !CrossingGuard::pair_crosses(trial, reshape, mesh, columns, front, f, g)
+    })
+}
+
+/// Of the stops of one root of `faces` (with its fan mates on a fan face, and every column
+/// merged into it) and, on a fan face, of one fan of it taken out of the groups its columns
+/// merged into ([`SlabPlan::stop_out_of_groups`]), the one that `accept`s the trial plan (given
+/// the invalid cells around before and after) and stops the fewest wall points; applied to
+/// `plan`, returning the columns whose cells change.
+fn stop_fewest(
+    plan: &mut SlabPlan,
+    reshape: &Reshape,
+    mesh: &VolumeMesh,
+    columns: &Columns,
+    front: &Front,
+    faces: &[usize],
+    accept: impl Fn(&SlabPlan, usize, usize) -> bool,
+) -> Option<Vec<u32>> {
+    let mut candidates: Vec<(Vec<u32>, bool)> = Vec::new();
+    for &f in faces {
+        let roots = plan.merges.face_roots(front, f);
+        if roots.len() < 2 {
+            continue;
         }
-        group
-    };
-    let mut candidates: Vec<(Vec<u32>, bool)> = roots.iter().map(|&r| (with_mates(r), false)).collect();
-    if fan_face {
-        let merged = front.face_columns(f).iter().filter(|&&c| plan.merges.is_merged(c));
-        candidates.extend(merged.map(|&c| (with_mates(c), true)));
+        let fan_face = face_fan_edges(front, columns, f).contains(&true);
+        let with_mates = |c: u32| {
+            let mut group = vec![c];
+            if fan_face {
+                add_fan_mates(front, columns, &mut group);
+            }
+            group
+        };
+        candidates.extend(roots.iter().map(|&r| (with_mates(r), false)));
+        if fan_face {
+            let merged = front.face_columns(f).iter().filter(|&&c| plan.merges.is_merged(c));
+            candidates.extend(merged.map(|&c| (with_mates(c), true)));
+        }
     }
     let mut best: Option<(usize, SlabPlan, Vec<u32>)> = None;
     for (group, out_of_groups) in candidates {
@@ -1061,9 +1110,8 @@ fn stop_fewest_columns(
         let mut trial = plan.clone();
         let changed = if out_of_groups { trial.stop_out_of_groups(&group) } else { trial.stop_all(group) };
         let stopped = wall_point_count(columns, &changed);
-        if face_cell_is_valid(&trial, reshape, mesh, columns, front, f)
-            && invalid_cells_around(&trial, reshape, mesh, columns, front, &around) < before
-            && best.as_ref().is_none_or(|b| stopped < b.0)
+        if best.as_ref().is_none_or(|b| stopped < b.0)
+            && accept(&trial, before, invalid_cells_around(&trial, reshape, mesh, columns, front, &around))
         {
             best = Some((stopped, trial, changed));
         }
