@@ -705,18 +705,8 @@ fn settle_slab(
                 changed.extend(merged);
                 continue;
             }
-            // In the transition layers a stop costs no stack its full count, and stopping both
-            // faces leaves the core a plainer front than a pit one column wide.
-            let within_count = [f, g]
-                .iter()
-                .flat_map(|&h| front.face_columns(h))
-                .any(|&c| columns.full_count(c as usize).is_some_and(|n| k <= n));
-            let fewest = if within_count {
-                stop_fewest_to_uncross(&mut plan, reshape, mesh, columns, front, (f, g))
-            } else {
-                None
-            };
-            let stopped = fewest.unwrap_or_else(|| stop_to_uncross(&mut plan, front, columns, f, g));
+            let stopped = stop_fewest_to_uncross(&mut plan, reshape, mesh, columns, front, (f, g), k)
+                .unwrap_or_else(|| stop_to_uncross(&mut plan, front, columns, f, g));
             plan.uncrossed.extend(&stopped);
             changed.extend(stopped);
         }
@@ -1055,7 +1045,9 @@ fn stop_fewest_columns(
 /// leaving no more invalid cells around; `None` when no single stop does. Stopping both faces'
 /// columns would stop every column merged into their roots too: where a ridge's fan meets its
 /// floor's front (a wing's trailing edge at its root), that is most of the crease between them.
-/// Used while a column of the two faces is within its full count.
+/// Only while a column of the two faces is within its full count at layer `k`: in the
+/// transition layers a stop costs no stack its count, and stopping both faces leaves the core a
+/// plainer front than a pit one column wide.
 fn stop_fewest_to_uncross(
     plan: &mut SlabPlan,
     reshape: &Reshape,
@@ -1063,7 +1055,15 @@ fn stop_fewest_to_uncross(
     columns: &Columns,
     front: &Front,
     (f, g): (usize, usize),
+    k: u32,
 ) -> Option<Vec<u32>> {
+    let within_count = [f, g]
+        .iter()
+        .flat_map(|&h| front.face_columns(h))
+        .any(|&c| columns.full_count(c as usize).is_some_and(|n| k <= n));
+    if !within_count {
+        return None;
+    }
     stop_fewest(plan, reshape, mesh, columns, front, &[f, g], |trial, before, after| {
         after <= before && !CrossingGuard::pair_crosses(trial, reshape, mesh, columns, front, f, g)
     })
