@@ -362,21 +362,23 @@ impl LayersAndCore<'_> {
                 lowered = lowered_instead.iter().zip(&caps).filter(|(a, b)| a != b).count();
                 caps.clone_from(&lowered_instead);
             }
-            let lowered = lowered + marked.len();
-            marked_last = marked;
+            // The next round differs where tops were marked or caps lowered.
+            let next_differs = !marked.is_empty() || lowered > 0;
             tracing::info!(
                 round,
                 slivers = this.slivers.tets.len(),
                 worst = this.slivers.worst,
+                marked = marked.len(),
                 lowered,
                 "core slivers"
             );
+            marked_last = marked;
             if best.as_ref().is_none_or(|b| this.slivers.better_than(&b.slivers)) {
                 stats.kept_round = round;
                 kept_caps = capped_now;
                 best = Some(this);
             }
-            if lowered == 0 || round - stats.kept_round >= PEEL_PATIENCE {
+            if !next_differs || round - stats.kept_round >= PEEL_PATIENCE {
                 break;
             }
         }
