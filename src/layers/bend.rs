@@ -15,11 +15,8 @@
 use super::entropy::neighbour_roots;
 use super::front::{Columns, Front};
 use super::slab_plan::SlabPlan;
+use super::tuning::TUNING;
 use crate::geometry::DVec3;
-
-/// How far a column turns to its neighbours' mean direction, tried in order (the least bend
-/// that mends first).
-const BENDS: [f64; 3] = [0.25, 0.5, 1.0];
 
 /// Bend one moving root of invalid face `f` (see the module doc) so that `f`'s cell is valid
 /// and fewer cells around the root are invalid; returns the root. Fan columns are left alone:
@@ -41,7 +38,7 @@ pub(super) fn bend_to_mend(
         let c = r as usize;
         let node = points[columns.node[c] as usize];
         let step = plan.proposed[c].distance(node);
-        for w in BENDS {
+        for w in TUNING.repairs.bends {
             let dir = columns.dir[c].lerp(mean, w).normalize_or_zero();
             if dir == DVec3::ZERO {
                 continue;
@@ -93,9 +90,6 @@ fn move_top(plan: &mut SlabPlan, r: u32, top: DVec3, (dir, scale): (DVec3, f64))
     plan.redirected.push((r, dir, scale));
 }
 
-/// How far a top is tipped sideways to mend a cell, as a fraction of its step, tried in order.
-const NUDGES: [f64; 4] = [0.1, 0.2, 0.35, 0.5];
-
 /// Tip one moving root of invalid face `f` sideways (its step keeps its length; eight ways round
 /// its direction, the least tip first) so that `f`'s cell is valid and fewer cells around the
 /// root are invalid; returns the root. The last repair before stopping columns, for cells that
@@ -132,7 +126,7 @@ pub(super) fn nudge_to_mend(
             .find(|e| e.0 == r)
             .map_or((columns.dir[c], columns.scale[c]), |e| (e.1, e.2));
         let (e1, e2) = along.any_orthonormal_pair();
-        for t in NUDGES {
+        for t in TUNING.repairs.nudges {
             let tips = (0..8).map(|i| {
                 let a = i as f64 * std::f64::consts::FRAC_PI_4;
                 let tipped = (along + t * (a.cos() * e1 + a.sin() * e2)).normalize();

@@ -1,19 +1,19 @@
-//! Tangential collapse of short front edges (tangential adaptivity): a
-//! front edge whose proposed top is shorter than [`COLLAPSE_LENGTH`] against its size
-//! ([`EdgeSizes::collapse_length`]: the target, or a part of its length on the wall where shorter)
-//! merges its two columns into one, as the entropy collapse does ([`super::entropy::collapse`]):
-//! a column ends. It is the inverse of the split
+//! Tangential collapse of short front edges (tangential adaptivity): a front edge whose proposed
+//! top is shorter than
+//! [`TUNING.adaptation.collapse_length`](super::tuning::Adaptation::collapse_length) against its
+//! size ([`EdgeSizes::collapse_length`]: the target, or a part of its length on the wall where
+//! shorter) merges its two columns into one, as the entropy collapse does
+//! ([`super::entropy::collapse`]): a column ends. It is the inverse of the split
 //! ([`super::split`]): where the field coarsens (out of a refinement region) or the front
 //! compresses (concave walls), the front's edges stay near the wanted size.
 //!
 //! Collapses are tried shortest edge first, in rounds of at most one per column, until a round
-//! makes none (or [`MAX_ROUNDS`]): a front leaving a refinement region coarsens by up to a factor
-//! of 2^rounds a layer. Each must pass the link condition
-//! ([`super::collapse::Merges::can_collapse`]) and leave every cell around it valid (exact
-//! predicates); one that does not is undone. Fan edges (copies of one wall vertex) never
+//! makes none (or
+//! [`TUNING.adaptation.collapse_rounds`](super::tuning::Adaptation::collapse_rounds)): a front
+//! leaving a refinement region coarsens by up to a factor of 2^rounds a layer. Each must pass the
+//! link condition ([`super::collapse::Merges::can_collapse`]) and leave every cell around it valid
+//! (exact predicates); one that does not is undone. Fan edges (copies of one wall vertex) never
 //! collapse: they open with the distance and are what makes the fan.
-
-use std::f64::consts::FRAC_1_SQRT_2;
 
 use rayon::prelude::*;
 
@@ -21,25 +21,15 @@ use super::entropy;
 use super::front::{Columns, Front};
 use super::slab_plan::SlabPlan;
 use super::split::EdgeSizes;
-
-/// A front edge shorter than this against the collapse sizes is collapsed.
-pub const COLLAPSE_LENGTH: f64 = FRAC_1_SQRT_2;
-
-/// Rounds of collapses in one slab.
-pub const MAX_ROUNDS: usize = 3;
-
-/// A front edge shorter than this against the collapse sizes that no collapse could take is
-/// crushed ([`Coarsening::crushed`]): its cells are needles along the front. Fandisk's two
-/// fans crossing were at 0.017 and 0.037; at 0.1 the arrow's fin roots ended too (0.053 to
-/// 0.09, where the fin and body fronts meet and a later layer's merges take them), and their
-/// pits left core slivers where it had none.
-pub const CRUSHED_LENGTH: f64 = 0.05;
+use super::tuning::TUNING;
 
 /// What [`collapse_short_edges`] did.
 pub(super) struct Coarsening {
     /// The edges collapsed, as the pairs of columns `(a, b)`, `a < b`, that were their ends.
     pub made: Vec<(u32, u32)>,
-    /// The short edges left shorter than [`CRUSHED_LENGTH`], as root pairs.
+    /// The short edges left shorter than
+    /// [`TUNING.adaptation.crushed_length`](super::tuning::Adaptation::crushed_length), as root
+    /// pairs.
     pub crushed: Vec<(u32, u32)>,
 }
 
@@ -61,7 +51,7 @@ pub(super) fn collapse_short_edges(
     // The short edges under the plan as it is: a round that collapses nothing leaves the plan
     // as it was (a collapse that fails is undone), so its list stays the plan's.
     let mut short = short_edges(plan, front, columns, &sizes);
-    for _ in 0..MAX_ROUNDS {
+    for _ in 0..TUNING.adaptation.collapse_rounds {
         let mut shortest_first = short.clone();
         shortest_first.sort_unstable_by(|x, y| x.0.total_cmp(&y.0));
         let mut touched = vec![false; columns.len()];
@@ -85,15 +75,18 @@ pub(super) fn collapse_short_edges(
         }
         short = short_edges(plan, front, columns, &sizes);
     }
-    let crushed =
-        short.into_iter().filter(|&(length, _, _)| length < CRUSHED_LENGTH).map(|(_, a, b)| (a, b)).collect();
+    let crushed = short
+        .into_iter()
+        .filter(|&(length, _, _)| length < TUNING.adaptation.crushed_length)
+        .map(|(_, a, b)| (a, b))
+        .collect();
     Coarsening { made, crushed }
 }
 
 /// The front edges `(length, a, b)` between two moving roots (after the merges so far) that are
-/// shorter than [`COLLAPSE_LENGTH`] against the sizes `[target, layer height, user]`
-/// ([`EdgeSizes::collapse_length`]), each once; fan edges and edges between columns that slide
-/// differently are left out.
+/// shorter than [`TUNING.adaptation.collapse_length`](super::tuning::Adaptation::collapse_length)
+/// against the sizes `[target, layer height, user]` ([`EdgeSizes::collapse_length`]), each once;
+/// fan edges and edges between columns that slide differently are left out.
 fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, sizes: &EdgeSizes) -> Vec<(f64, u32, u32)> {
     let root = |c: u32| plan.merges.root(c) as usize;
     // Filtered by face in parallel, then ordered by their ends: the few short edges are all
@@ -112,7 +105,7 @@ fn short_edges(plan: &SlabPlan, front: &Front, columns: &Columns, sizes: &EdgeSi
                     && columns.slide[a] == columns.slide[b];
                 let length = short
                     .then(|| sizes.collapse_length(columns, a, b, plan.proposed[b] - plan.proposed[a]))?;
-                (length < COLLAPSE_LENGTH).then_some((length, a as u32, b as u32))
+                (length < TUNING.adaptation.collapse_length).then_some((length, a as u32, b as u32))
             })
         })
         .collect();

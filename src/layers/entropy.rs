@@ -35,20 +35,12 @@ use rayon::prelude::*;
 use super::front::{Columns, Front};
 use super::slab::Polygon;
 use super::slab_plan::SlabPlan;
-use super::unfold::CAP_ANGLE;
+use super::tuning::TUNING;
 use crate::geometry::distance::closest_point_on_triangle;
 use crate::geometry::triangle_max_angle;
 use crate::sizing::wall::WallDistance;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
-
-/// Two columns meet when their proposed top edge keeps less than this fraction of its bottom
-/// edge: merging them then moves neither far (merging columns still apart twists the lateral
-/// faces of the cells around them).
-pub const MEETING_RATIO: f64 = 0.25;
-
-/// Two scales closer than this ratio are the same kind of column.
-const SAME_SCALE: f64 = 1.01;
 
 /// Signed length of the top edge (`top_a`, `top_b`) along the bottom edge (`a`, `b`), relative
 /// to the bottom edge: 1 for parallel columns, less where they converge, negative once crossed.
@@ -225,13 +217,13 @@ pub(super) fn merge_bisector_crossings(
     walls: &VertexWalls,
     invalid_cells: impl Fn(&SlabPlan, &[u32]) -> usize,
 ) {
-    // A column passes only the bisectors of neighbours with a larger scale by RIDGE_SCALE
+    // A column passes only the bisectors of neighbours with a larger scale by the ridge scale
     // ([`passed_bisectors`]): none beyond the largest scale of all.
     let largest_scale = columns.scale.iter().copied().fold(0.0, f64::max);
     loop {
         let mut merged = false;
         for c in 0..columns.len() as u32 {
-            let below_a_ridge = columns.scale[c as usize] * RIDGE_SCALE <= largest_scale;
+            let below_a_ridge = columns.scale[c as usize] * TUNING.entropy.ridge_scale <= largest_scale;
             if !plan.moving[c as usize] || plan.merges.is_merged(c) || !below_a_ridge {
                 continue;
             }
@@ -243,11 +235,12 @@ pub(super) fn merge_bisector_crossings(
             let key = |x: u32| {
                 (flattened_if_merged(plan, front, columns, points, x, c), top(x).distance_squared(top(c)))
             };
-            let Some(r) = passed_bisectors(plan, front, columns, points, walls, c, ANTICIPATION)
-                .into_iter()
-                .map(|x| (key(x), x))
-                .min_by(|(kx, _), (ky, _)| kx.0.cmp(&ky.0).then(kx.1.total_cmp(&ky.1)))
-                .map(|(_, x)| x)
+            let Some(r) =
+                passed_bisectors(plan, front, columns, points, walls, c, TUNING.entropy.anticipation)
+                    .into_iter()
+                    .map(|x| (key(x), x))
+                    .min_by(|(kx, _), (ky, _)| kx.0.cmp(&ky.0).then(kx.1.total_cmp(&ky.1)))
+                    .map(|(_, x)| x)
             else {
                 continue;
             };
@@ -266,22 +259,11 @@ pub(super) fn merge_bisector_crossings(
     }
 }
 
-/// A column has been overtaken by another wall's front once its proposed top lags its layer's
-/// distance from the wall by more than this many of its layer's heights, counting
-/// [`ANTICIPATION`] times what it fell behind in this layer.
-const OVERTAKEN: f64 = 0.1;
-
-/// A column falling behind by less than this many layer heights in one layer is not being
-/// overtaken: a split column (a chord across a convex front) lags the offset by as much at its
-/// bottom as at its top, and so do faceting errors. (The lag of a column passing a 90-degree
-/// ridge's bisector grows by about one height per layer; with no floor on it every column
-/// counts as late: fandisk's coverage near concave ridges fell to 50%.)
-const FALLING_BEHIND: f64 = 0.25;
-
 /// How late root `c`'s proposed top (its `k`-th layer) is on the first-arrival offset: its lag
-/// behind the layer's distance from the wall, in layer heights, plus [`ANTICIPATION`] times
-/// what it fell behind since its bottom; 0 for a column not falling behind
-/// ([`FALLING_BEHIND`]) or past its stack.
+/// behind the layer's distance from the wall, in layer heights, plus
+/// [`TUNING.entropy.anticipation`](super::tuning::Entropy::anticipation) times what it fell behind
+/// since its bottom; 0 for a column not falling behind
+/// ([`TUNING.entropy.falling_behind`](super::tuning::Entropy::falling_behind)) or past its stack.
 fn lateness(
     plan: &SlabPlan,
     columns: &Columns,
@@ -299,29 +281,30 @@ fn lateness(
         return 0.0;
     }
     let (top_point, bottom_point) = (plan.proposed[c as usize], points[columns.node[c as usize] as usize]);
-    // Falling behind means a top less than (1 - FALLING_BEHIND) h farther from the walls than
+    // Falling behind means a top less than (1 - falling_behind) h farther from the walls than
     // the bottom: with the bottom's distance bounded by its own wall's triangles, most columns
     // are ruled out by a search that skips everything farther (the margin covers rounding).
-    let reach =
-        walls.distance_bound(columns.wall_vertex[c as usize], bottom_point) + (1.0 - FALLING_BEHIND) * h;
+    let reach = walls.distance_bound(columns.wall_vertex[c as usize], bottom_point)
+        + (1.0 - TUNING.entropy.falling_behind) * h;
     let Some(top_distance) = walls.distance_within(top_point, reach + 1e-9 * (reach.abs() + h)) else {
         return 0.0;
     };
     let top = (d - top_distance) / h;
     let bottom = (d_below - walls.distance(bottom_point)) / h;
-    if top - bottom > FALLING_BEHIND {
-        top + ANTICIPATION * (top - bottom)
+    if top - bottom > TUNING.entropy.falling_behind {
+        top + TUNING.entropy.anticipation * (top - bottom)
     } else {
         0.0
     }
 }
 
-/// Merge every column that another wall's front has overtaken ([`OVERTAKEN`]) into a neighbour
-/// root that is on time (the least late that the cells allow), which keeps its top: the
-/// first-arrival rule itself, wherever fronts meet, with or without a feature ridge between
-/// them (a step narrower than the layers are thick, a fin's edge at a body, a concave valley).
-/// The latest go first. A column whose neighbours are all late (fronts meeting head on across
-/// a gap) is left to the crossing guard, which ends the stacks at the medial surface.
+/// Merge every column that another wall's front has overtaken
+/// ([`TUNING.entropy.overtaken`](super::tuning::Entropy::overtaken)) into a neighbour root that is
+/// on time (the least late that the cells allow), which keeps its top: the first-arrival rule
+/// itself, wherever fronts meet, with or without a feature ridge between them (a step narrower than
+/// the layers are thick, a fin's edge at a body, a concave valley). The latest go first. A column
+/// whose neighbours are all late (fronts meeting head on across a gap) is left to the crossing
+/// guard, which ends the stacks at the medial surface.
 pub(super) fn merge_overtaken(
     plan: &mut SlabPlan,
     front: &Front,
@@ -339,7 +322,7 @@ pub(super) fn merge_overtaken(
         .collect();
     loop {
         let mut overtaken: Vec<(f64, u32)> = (0..columns.len() as u32)
-            .filter(|&c| is_root(plan, c) && late[c as usize] > OVERTAKEN)
+            .filter(|&c| is_root(plan, c) && late[c as usize] > TUNING.entropy.overtaken)
             .map(|c| (late[c as usize], c))
             .collect();
         overtaken.sort_by(|x, y| y.0.total_cmp(&x.0));
@@ -354,7 +337,7 @@ pub(super) fn merge_overtaken(
                 .into_iter()
                 .filter(|&r| is_root(plan, r) && can_merge(plan, front, columns, r, c))
                 .map(|r| (late[r as usize], apart(r), r))
-                .filter(|&(l, _, _)| l <= OVERTAKEN)
+                .filter(|&(l, _, _)| l <= TUNING.entropy.overtaken)
                 .collect();
             on_time.sort_by(|x, y| x.0.total_cmp(&y.0).then(x.1.total_cmp(&y.1)));
             merged |= on_time.into_iter().any(|(_, _, r)| {
@@ -371,24 +354,22 @@ pub(super) fn merge_overtaken(
     }
 }
 
-/// A flat top whose longest edge keeps at least this fraction of its bottom's is flat along a
-/// line.
-const LINE_LIKE: f64 = 0.5;
-
-/// Collapse the shortest top edge of every face left flat or turned over ([`FLAT_TOP`]) along
-/// a line ([`LINE_LIKE`]), with three corners or more still apart, if the cells around allow
-/// it. The merges make such faces: where the face columns beside a ridge merge into its ridge
-/// columns, one that goes back along the ridge next to one that goes forward leaves the face
-/// between them flat along the bisector, over three ridge columns ([`flattened_if_merged`]
-/// avoids it only where a choice is left); the other wall's front meets the ridge's middle
-/// column, the flat face does not, and the two cross. Merging the middle ridge column with one
-/// beside it (equal columns meet in the middle, on the bisector of a straight ridge) gives both
-/// sides the same edge there. So do a wall edge far shorter than the layer (its face turns
-/// over in one layer) and a valley narrower than the layers (its faces squeezed flat).
-/// A triangle whose top is a cap ([`CAP_ANGLE`]) on a crease counts as flat whatever its area:
-/// where two walls' columns converge on their bisector (a post's or a wing's foot), a column
-/// about to reach it has its top nearly on the line of two that did (they carry merged
-/// columns); left so on the final front, every core tetrahedron on that cap is a sliver. Its
+/// Collapse the shortest top edge of every face left flat or turned over
+/// ([`TUNING.entropy.flat_top`](super::tuning::Entropy::flat_top)) along a line
+/// ([`TUNING.entropy.line_like`](super::tuning::Entropy::line_like)), with three corners or more
+/// still apart, if the cells around allow it. The merges make such faces: where the face columns
+/// beside a ridge merge into its ridge columns, one that goes back along the ridge next to one that
+/// goes forward leaves the face between them flat along the bisector, over three ridge columns
+/// ([`flattened_if_merged`] avoids it only where a choice is left); the other wall's front meets
+/// the ridge's middle column, the flat face does not, and the two cross. Merging the middle ridge
+/// column with one beside it (equal columns meet in the middle, on the bisector of a straight
+/// ridge) gives both sides the same edge there. So do a wall edge far shorter than the layer (its
+/// face turns over in one layer) and a valley narrower than the layers (its faces squeezed flat).
+/// A triangle whose top is a cap
+/// ([`TUNING.unfolding.cap_angle`](super::tuning::Unfolding::cap_angle)) on a crease counts as flat
+/// whatever its area: where two walls' columns converge on their bisector (a post's or a wing's
+/// foot), a column about to reach it has its top nearly on the line of two that did (they carry
+/// merged columns); left so on the final front, every core tetrahedron on that cap is a sliver. Its
 /// shortest edge, the middle corner to the nearer end, is merged first: the column meets the
 /// bisector a step early. Such a cap's cell is valid, so its merge must leave every cell around
 /// valid; a cap with a fan's column is the front wrapping round a convex edge, not a crease.
@@ -423,10 +404,10 @@ pub(super) fn merge_flat_tops(
         };
         let on_crease = |c: u32| carries[c as usize] || plan.merges.group(c).nth(1).is_some();
         let cap = n.len() == 3
-            && triangle_max_angle(top(n[0]), top(n[1]), top(n[2])) > CAP_ANGLE
+            && triangle_max_angle(top(n[0]), top(n[1]), top(n[2])) > TUNING.unfolding.cap_angle
             && !n.iter().any(|&c| in_fan(c))
             && long_edge_ends(n, &top).iter().all(|&c| on_crease(c));
-        let flat = area_ratio(plan, front, f, columns, points).is_some_and(|a| a < FLAT_TOP);
+        let flat = area_ratio(plan, front, f, columns, points).is_some_and(|a| a < TUNING.entropy.flat_top);
         if !cap && !flat {
             return None;
         }
@@ -435,7 +416,7 @@ pub(super) fn merge_flat_tops(
         let longest = |at: &dyn Fn(u32) -> DVec3| {
             (0..n.len()).map(|i| at(n[i]).distance(at(n[(i + 1) % n.len()]))).fold(0.0, f64::max)
         };
-        (longest(&top) >= LINE_LIKE * longest(&bottom)).then_some((face, !flat))
+        (longest(&top) >= TUNING.entropy.line_like * longest(&bottom)).then_some((face, !flat))
     };
     // Seen for every face in parallel under the plan as it comes; once a merge changed it, face
     // by face (a merge tried and undone leaves the plan as it was).
@@ -493,13 +474,10 @@ pub(super) fn neighbour_roots(plan: &SlabPlan, front: &Front, c: u32) -> Vec<u32
     roots
 }
 
-/// A face top keeping less than this fraction of its bottom's area, with three corners or more
-/// still apart, is flat.
-const FLAT_TOP: f64 = 0.05;
-
-/// How many faces around root `c`'s group would be left flat ([`FLAT_TOP`]) with three distinct
-/// corners if `c` merged into root `r`: two face columns beside a ridge merged into two ridge
-/// columns with a third between them fold the front along the ridge, every cell valid.
+/// How many faces around root `c`'s group would be left flat
+/// ([`TUNING.entropy.flat_top`](super::tuning::Entropy::flat_top)) with three distinct corners if
+/// `c` merged into root `r`: two face columns beside a ridge merged into two ridge columns with a
+/// third between them fold the front along the ridge, every cell valid.
 fn flattened_if_merged(
     plan: &SlabPlan,
     front: &Front,
@@ -518,7 +496,8 @@ fn flattened_if_merged(
             roots.sort_unstable();
             roots.dedup();
             roots.len() >= 3
-                && area_ratio_with(plan, front, f, columns, points, root).is_some_and(|a| a < FLAT_TOP)
+                && area_ratio_with(plan, front, f, columns, points, root)
+                    .is_some_and(|a| a < TUNING.entropy.flat_top)
         })
         .count()
 }
@@ -536,7 +515,7 @@ fn passed_bisectors(
 ) -> Vec<u32> {
     let mut passed = neighbour_roots(plan, front, c);
     passed.retain(|&r| {
-        columns.scale[c as usize] * RIDGE_SCALE <= columns.scale[r as usize]
+        columns.scale[c as usize] * TUNING.entropy.ridge_scale <= columns.scale[r as usize]
             && crosses_bisector(plan, columns, points, walls, r, c, anticipation)
     });
     passed
@@ -558,8 +537,10 @@ fn crosses_bisector(
     // `r` must be the bisector of `c`'s wall and another at its vertex: `c`'s direction
     // mirrored about `d` is that other wall's normal (not so for a fan's column at a saddle,
     // nor at a corner of three walls, which the cells' tests handle).
-    let is_wall = |m: DVec3| walls.at(columns.wall_vertex[r as usize]).any(|w| w.dot(m) >= SAME_WALL_COSINE);
-    if across.length() < MIN_BISECTOR_SINE || !is_wall(n) || !is_wall(2.0 * n.dot(d) * d - n) {
+    let is_wall = |m: DVec3| {
+        walls.at(columns.wall_vertex[r as usize]).any(|w| w.dot(m) >= TUNING.entropy.same_wall_cosine)
+    };
+    if across.length() < TUNING.entropy.min_bisector_sine || !is_wall(n) || !is_wall(2.0 * n.dot(d) * d - n) {
         return false;
     }
     let bottom = |x: u32| points[columns.node[x as usize] as usize];
@@ -567,22 +548,22 @@ fn crosses_bisector(
     let apart = bottom(c) - bottom(r);
     let (before, after) = (apart.dot(across), (top(c) - top(r)).dot(across));
     // An edge along the ridge (where it fades out, say) starts on the bisector: no crossing.
-    if -before < ACROSS_RIDGE * across.length() * apart.length() {
+    if -before < TUNING.entropy.across_ridge * across.length() * apart.length() {
         return false;
     }
-    // Passed, or short of it by less than it closed in this layer: the next layer would take
-    // it past (at 0.5 of the approach: flange 89.8% near concave, fandisk 95.3%, arrow 68.1%;
-    // at 1: 93.7%, 95.9%, 69.3%; at 1.5 fandisk 97.6% but flange 86.9%).
+    // Passed, or short of it by less than `anticipation` times what it closed in this layer: as
+    // many more layers would take it past.
     before < 0.0 && after + anticipation * (after - before) >= 0.0
 }
 
 /// Repair invalid face `f` by merging one of its face columns into the bisector column beside it
-/// that it will pass within [`REPAIR_ANTICIPATION`] of its last approaches (with its fan mates,
-/// if it is a fan's), if that leaves fewer invalid cells around; returns the surviving root. On a
-/// thin wall triangle along a ridge, one corner merging on time can turn the cell over while the
-/// next corner is a layer short of the bisector: merging that one early keeps the cell, where a
-/// general earlier merge would take the front off the offset elsewhere (at 1.5 approaches
-/// everywhere, the flange fell to 86.9%).
+/// that it will pass within
+/// [`TUNING.entropy.repair_anticipation`](super::tuning::Entropy::repair_anticipation) of its last
+/// approaches (with its fan mates, if it is a fan's), if that leaves fewer invalid cells around;
+/// returns the surviving root. On a thin wall triangle along a ridge, one corner merging on time
+/// can turn the cell over while the next corner is a layer short of the bisector: merging that one
+/// early keeps the cell, where a general earlier merge would take the front off the offset
+/// elsewhere (at 1.5 approaches everywhere, the flange fell to 86.9%).
 pub(super) fn merge_before_crossing(
     plan: &mut SlabPlan,
     front: &Front,
@@ -598,7 +579,8 @@ pub(super) fn merge_before_crossing(
         .face_roots(front, f)
         .iter()
         .flat_map(|&c| {
-            let passed = passed_bisectors(plan, front, columns, points, walls, c, REPAIR_ANTICIPATION);
+            let passed =
+                passed_bisectors(plan, front, columns, points, walls, c, TUNING.entropy.repair_anticipation);
             passed.into_iter().map(move |r| (r, c))
         })
         .filter(|&(r, c)| can_merge(plan, front, columns, r, c))
@@ -621,23 +603,6 @@ pub(super) fn merge_before_crossing(
     None
 }
 
-/// How many of its last approaches to a bisector ahead a column may be merged to mend a cell.
-const REPAIR_ANTICIPATION: f64 = 2.0;
-
-/// The edge from a ridge column to a face column must run this much across the bisector
-/// (cosine of its angle to the bisector plane's normal): ridge edges lie in the plane.
-const ACROSS_RIDGE: f64 = 0.1;
-
-/// A column's direction within this cosine of a wall triangle's normal is that wall's.
-const SAME_WALL_COSINE: f64 = 0.9;
-
-/// Directions closer than this (the length of `n - (n . d) d`, the sine of their angle) leave
-/// the bisector test undecided.
-const MIN_BISECTOR_SINE: f64 = 0.2;
-
-/// How many of its last approaches to a bisector ahead a column is merged.
-const ANTICIPATION: f64 = 1.0;
-
 /// Collapse the corner of invalid triangle `f` that closes in fastest on its opposite edge into
 /// the nearer end of that edge, if the front allows it; returns the surviving root. This is a
 /// bisector column overtaking the face columns in front of it along a ridge whose wall edges
@@ -656,18 +621,6 @@ fn collapse_crossing_corner(
     collapse(plan, columns, v, w);
     Some(plan.merges.root(v))
 }
-
-/// A face with a column whose extrusion scale exceeds another's by this ratio spans a ridge (a
-/// concave ridge's bisector column has `1/sin(phi/2)`: 1.1 for phi = 130 degrees).
-const RIDGE_SCALE: f64 = 1.1;
-
-/// A corner whose height over its opposite edge falls below this fraction of what it was, in
-/// one layer, is closing in on it.
-const CLOSING_IN: f64 = 0.5;
-
-/// A wall triangle whose corner stands less than this fraction of its opposite edge's length
-/// over it is a sliver there.
-const SLIVER: f64 = 0.2;
 
 /// Whether roots `v` and `w` may merge: both moving, the front stays a manifold, and they are
 /// not two columns of one fan or columns that slide differently.
@@ -716,9 +669,10 @@ fn can_merge_fan_mate(plan: &SlabPlan, front: &Front, columns: &Columns, v: u32,
 }
 
 /// The corner of triangle `f` (after the merges so far) whose height over its opposite edge
-/// falls most this layer, if below [`CLOSING_IN`] of what it was: the corner and the ends of
-/// its edge, nearer end (at the proposed tops) first. Heights are seen along the face's mean
-/// column direction. Only a face spanning a ridge, and not a sliver on the wall, has one.
+/// falls most this layer, if below
+/// [`TUNING.entropy.closing_in`](super::tuning::Entropy::closing_in) of what it was: the corner and
+/// the ends of its edge, nearer end (at the proposed tops) first. Heights are seen along the face's
+/// mean column direction. Only a face spanning a ridge, and not a sliver on the wall, has one.
 fn crossing_corner(
     plan: &SlabPlan,
     front: &Front,
@@ -731,7 +685,7 @@ fn crossing_corner(
     // Only along a ridge: a bisector column (a larger extrusion scale) among face columns.
     let scales = [a, b, c].map(|r| columns.scale[r as usize]);
     if scales.iter().fold(0.0f64, |m, &s| m.max(s))
-        < RIDGE_SCALE * scales.iter().fold(f64::INFINITY, |m, &s| m.min(s))
+        < TUNING.entropy.ridge_scale * scales.iter().fold(f64::INFINITY, |m, &s| m.min(s))
     {
         return None;
     }
@@ -745,7 +699,8 @@ fn crossing_corner(
         let at_top = corner_height(axis, top(v), top(w0), top(w1));
         // A sliver on the wall (a long edge with its corner close by) turns over by the least
         // difference between its columns: that is no meeting of fronts.
-        let sliver = corner_height(axis, wall(v), wall(w0), wall(w1)) < SLIVER * wall(w0).distance(wall(w1));
+        let sliver = corner_height(axis, wall(v), wall(w0), wall(w1))
+            < TUNING.entropy.sliver * wall(w0).distance(wall(w1));
         if at_bottom > 0.0 && !sliver {
             at_top / at_bottom
         } else {
@@ -755,7 +710,7 @@ fn crossing_corner(
     let (_, v, mut ends) = [(a, [b, c]), (b, [c, a]), (c, [a, b])]
         .into_iter()
         .map(|(v, e)| (height_ratio(v, e), v, e))
-        .filter(|&(ratio, _, _)| ratio < CLOSING_IN)
+        .filter(|&(ratio, _, _)| ratio < TUNING.entropy.closing_in)
         .min_by(|x, y| x.0.total_cmp(&y.0))?;
     let nearer = |w: u32| top(v).distance_squared(top(w));
     ends.sort_by(|x, y| nearer(*x).total_cmp(&nearer(*y)));
@@ -788,7 +743,7 @@ fn collapse_most_shrunk_edge(
         .map(|i| (n[i], n[(i + 1) % n.len()]))
         .filter(|&(a, b)| moving_roots(plan, a, b) && plan.merges.can_collapse(front, a, b))
         .map(|(a, b)| (edge_ratio(plan, columns, points, a, b), a, b))
-        .filter(|&(ratio, _, _)| ratio < MEETING_RATIO)
+        .filter(|&(ratio, _, _)| ratio < TUNING.entropy.meeting_ratio)
         .min_by(|x, y| x.0.total_cmp(&y.0))?;
     collapse(plan, columns, a, b);
     Some(plan.merges.root(a))
@@ -894,7 +849,7 @@ pub(super) fn merge_into_crease(
     // The highest meeting point, from the middle of the V down to the crease's top, that keeps
     // every cell valid: the crease's column carries cells below it that a jump up turns over,
     // the V's columns fan cells that a drop onto the crease does.
-    for part in MEETING_HEIGHTS {
+    for part in TUNING.entropy.meeting_heights {
         for &(r, crease_top, middle) in &meetings {
             plan.proposed[r as usize] = columns.slide[r as usize].project(crease_top.lerp(middle, part));
         }
@@ -1123,10 +1078,6 @@ pub(super) fn retreat_fans(
     Some(group)
 }
 
-/// Where a V's columns merging into its crease may meet, as parts of the way from the crease's
-/// top to the middle of the V's tops, tried in turn.
-const MEETING_HEIGHTS: [f64; 5] = [1.0, 0.75, 0.5, 0.25, 0.0];
-
 /// The edge two polygons share (consecutive in both), if any.
 fn shared_edge(a: &[u32], b: &[u32]) -> Option<[u32; 2]> {
     (0..a.len()).map(|i| [a[i], a[(i + 1) % a.len()]]).find(|&[x, y]| {
@@ -1141,9 +1092,9 @@ fn shared_edge(a: &[u32], b: &[u32]) -> Option<[u32; 2]> {
 /// moves to the middle: the bisector column (larger scale) survives; equals meet in the middle.
 fn survivor(columns: &Columns, a: u32, b: u32) -> (u32, u32, bool) {
     let (sa, sb) = (columns.scale[a as usize], columns.scale[b as usize]);
-    if sa > sb * SAME_SCALE {
+    if sa > sb * TUNING.entropy.same_scale {
         (a, b, false)
-    } else if sb > sa * SAME_SCALE {
+    } else if sb > sa * TUNING.entropy.same_scale {
         (b, a, false)
     } else {
         (a.min(b), a.max(b), true)
@@ -1229,7 +1180,7 @@ mod tests {
     /// and wall 2 (x = 0, y > 0, normal +x): column 0 on the ridge, column 1 at `at` on the
     /// wall with direction `dir`, both `d` out (the ridge column by its scale, on the bisector).
     fn ridge_case(at: DVec3, dir: DVec3, d: f64) -> bool {
-        ridge_case_ahead(at, dir, d, ANTICIPATION)
+        ridge_case_ahead(at, dir, d, TUNING.entropy.anticipation)
     }
 
     fn ridge_case_ahead(at: DVec3, dir: DVec3, d: f64, anticipation: f64) -> bool {
@@ -1269,8 +1220,8 @@ mod tests {
         assert!(!ridge_case(at, DVec3::Z, 0.2));
         assert!(!ridge_case(DVec3::new(0.0, 0.0, 0.1), DVec3::Y, 0.2));
         // To mend a cell, a column two approaches short of the bisector merges, not three.
-        assert!(ridge_case_ahead(at, DVec3::Y, 0.04, REPAIR_ANTICIPATION));
-        assert!(!ridge_case_ahead(at, DVec3::Y, 0.02, REPAIR_ANTICIPATION));
+        assert!(ridge_case_ahead(at, DVec3::Y, 0.04, TUNING.entropy.repair_anticipation));
+        assert!(!ridge_case_ahead(at, DVec3::Y, 0.02, TUNING.entropy.repair_anticipation));
     }
 
     /// Lateness (in layer heights) of a column from `bottom` to `top` at its layer `k` of
@@ -1363,9 +1314,9 @@ mod tests {
         plan.merges.merge(1, 6);
         plan.merges.merge(3, 7);
         let flat = |plan: &SlabPlan| {
-            (0..front.len())
-                .filter(|&f| plan.merges.face_roots(&front, f).len() >= 3)
-                .any(|f| area_ratio(plan, &front, f, &columns, &bottoms).is_some_and(|a| a < FLAT_TOP))
+            (0..front.len()).filter(|&f| plan.merges.face_roots(&front, f).len() >= 3).any(|f| {
+                area_ratio(plan, &front, f, &columns, &bottoms).is_some_and(|a| a < TUNING.entropy.flat_top)
+            })
         };
         assert!(flat(&plan), "the face between the two merges lies flat on the ridge");
         assert_eq!(merge_flat_tops(&mut plan, &front, &columns, &bottoms, 1, |_, _| 0), 1);

@@ -8,25 +8,20 @@
 //! gap-limited when the front above its top has no room for the layer it could not build:
 //! climbing the exact wall distance from the top (away from the nearest wall points, along a
 //! shock where two meet) gains less than that layer before the climb stalls at the medial
-//! surface of a gap (where two walls within [`FACING_ANGLE_DEG`] of facing each other meet:
-//! across a slot, at a slot's bottom corners and lips, in a narrow wedge). Where the front
-//! closes on an axis, as in a bore, two layers. The fronts at a concave ridge of a wider angle
-//! go on along its bisector, so a stop there is never excused.
+//! surface of a gap (where two walls within
+//! [`TUNING.gaps.facing_angle_deg`](super::tuning::Gaps::facing_angle_deg) of facing each other
+//! meet: across a slot, at a slot's bottom corners and lips, in a narrow wedge). Where the front
+//! closes on an axis, as in a bore, two layers. The fronts at a concave ridge of a wider angle go
+//! on along its bisector, so a stop there is never excused.
 
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::Columns;
+use super::tuning::TUNING;
 use crate::geometry::bvh::TriangleBvh;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
-
-/// Walls whose normals are within this angle of opposite face each other across a gap.
-pub const FACING_ANGLE_DEG: f64 = 30.0;
-
-/// Hits nearer than this fraction of the column's first layer height are the wall at the
-/// column's own vertex.
-const OWN_WALL: f64 = 1e-3;
 
 /// For every wall vertex of `stopped` (ids into the surface's points), whether a column of it
 /// that stopped early is gap-limited; `points` are the layered mesh's points. (The columns of a
@@ -113,25 +108,25 @@ fn reaches_medial_surface(
     // fraction of its width and cannot be built (the flange's 1 mm bore: six layers reach 75%
     // of its radius, a seventh would reach 97%). Where the wall across faces back and the
     // front closes, two layers short of the medial surface is as far as it goes.
-    let Some((across, t)) = bvh.first_hit(base, dir, OWN_WALL * first, |_| false) else { return false };
+    let Some((across, t)) = bvh.first_hit(base, dir, TUNING.gaps.own_wall * first, |_| false) else {
+        return false;
+    };
     room < next + after
-        && surface.triangle_normal(t as usize).dot(dir) < -FACING_ANGLE_DEG.to_radians().cos()
-        && closes_on_an_axis(surface, bvh, (base, dir, OWN_WALL * first), across, wall_edges)
+        && surface.triangle_normal(t as usize).dot(dir) < -TUNING.gaps.facing_angle_deg.to_radians().cos()
+        && closes_on_an_axis(surface, bvh, (base, dir, TUNING.gaps.own_wall * first), across, wall_edges)
 }
 
-/// Steps of a climb per length `reach` ([`room_above`]).
-const CLIMB_STEPS: f64 = 16.0;
-
 /// How much farther from the wall (up to `reach`) the front can get above `top`: climb the
-/// wall distance from `top` in steps of `reach / CLIMB_STEPS`, along `heading` (the column's
+/// wall distance from `top` in steps of `reach / climb_steps`, along `heading` (the column's
 /// direction: a top still on the wall has no other) or away from the nearest wall point, or,
 /// where that step crosses a shock (another wall point becomes the nearest), along the shock,
-/// away from both; stop where no step gains `sin(FACING_ANGLE_DEG / 2)` of its
-/// length. That is the rise along the bisector of two walls at [`FACING_ANGLE_DEG`]: between
-/// walls that face each other more, the climb stalls at their medial surface.
+/// away from both; stop where no step gains `sin(facing_angle_deg / 2)` of its length (both of
+/// [`TUNING.gaps`](super::tuning::Gaps)). That is the rise along the bisector of two walls at the
+/// facing angle: between walls that face each other more, the climb stalls at their medial
+/// surface.
 pub fn room_above(bvh: &TriangleBvh, top: DVec3, mut heading: DVec3, reach: f64) -> f64 {
-    let step = reach / CLIMB_STEPS;
-    let least_rise = (0.5 * FACING_ANGLE_DEG).to_radians().sin() * step;
+    let step = reach / TUNING.gaps.climb_steps;
+    let least_rise = (0.5 * TUNING.gaps.facing_angle_deg).to_radians().sin() * step;
     let Some(start) = bvh.nearest(top) else { return f64::INFINITY };
     let away_from = |x: DVec3, n: &crate::geometry::bvh::Nearest| (x - n.point).normalize_or_zero();
     let (mut x, mut d) = (top, start.distance);
@@ -171,14 +166,6 @@ pub fn room_above(bvh: &TriangleBvh, top: DVec3, mut heading: DVec3, reach: f64)
     d - start.distance
 }
 
-/// Tilt (degrees) of the rays that probe whether the wall across curves around a column.
-const PROBE_TILT_DEG: f64 = 20.0;
-
-/// How much the probe rays also lean across their tilt (a fraction of it, both ways): at a
-/// bore's mouth the rays tilted along the rim would graze the far rim; leaning into the bore
-/// they hit its wall just inside (the flange's 1 mm bore: 0.035 mm inside).
-const PROBE_LEAN: f64 = 0.05;
-
 /// Whether the wall across a gap (`across` along `dir` from `base`, hits nearer than `skip`
 /// being the column's own wall) curves around the ray in one direction, as in a bore: rays
 /// tilted both ways in that direction hit it sooner than the straight one (a chord of the
@@ -192,7 +179,7 @@ fn closes_on_an_axis(
     across: f64,
     wall_edges: &[DVec3],
 ) -> bool {
-    let (sin, cos) = PROBE_TILT_DEG.to_radians().sin_cos();
+    let (sin, cos) = TUNING.gaps.probe_tilt_deg.to_radians().sin_cos();
     let u = dir.any_orthonormal_vector();
     let hit = |side: DVec3| bvh.first_hit(base, cos * dir + sin * side, skip, |_| false);
     let sooner = |side: DVec3| {
@@ -202,7 +189,7 @@ fn closes_on_an_axis(
     let sides: Vec<DVec3> =
         [u, dir.cross(u)].into_iter().chain(along_edges).filter(|s| *s != DVec3::ZERO).collect();
     sides.into_iter().any(|side| {
-        let lean = PROBE_LEAN * dir.cross(side);
+        let lean = TUNING.gaps.probe_lean * dir.cross(side);
         [lean, -lean].into_iter().any(|l| sooner(side + l) && sooner(-side + l))
     })
 }

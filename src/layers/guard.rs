@@ -17,6 +17,7 @@ use super::front::{Columns, Front};
 use super::slab::Polygon;
 use super::slab_plan::{Reshape, SlabPlan};
 use super::split::{self, NONE};
+use super::tuning::TUNING;
 use crate::geometry::grid::overlapping_pairs_where;
 use crate::geometry::intersect::{folds_over_shared_edge, meet_beyond_shared_vertex, triangles_intersect};
 use crate::geometry::Aabb;
@@ -24,21 +25,15 @@ use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
 use crate::quality::validity::cell_validity;
 
-/// Layers one set of candidate pairs covers when no collapse changes the front.
-pub const LOOKAHEAD_LAYERS: u32 = 4;
-
-/// Two triangles sharing a vertex whose columns' mean directions make a cosine below this may
-/// fold over it with both cells valid: the front turns sharply there (45 deg).
-const TURNED: f64 = std::f64::consts::FRAC_1_SQRT_2;
-
 /// Candidate pairs of front faces that may cross up to a given layer.
 #[derive(Debug, Default)]
 pub(super) struct CrossingGuard {
     /// Face pairs `(f, g)`, `f < g`, whose swept boxes overlap.
     pairs: Vec<(u32, u32)>,
     /// The triangles `(f, g)` sharing one column whose columns point apart by more than
-    /// [`TURNED`] seen from `f`, by `f` ([`turned_pairs`]): they hold while the pairs do (the
-    /// front's faces and the columns' directions change only where the pairs are rebuilt).
+    /// [`TUNING.guard.turned`](super::tuning::Guard::turned) seen from `f`, by `f`
+    /// ([`turned_pairs`]): they hold while the pairs do (the front's faces and the columns'
+    /// directions change only where the pairs are rebuilt).
     turned: Vec<(u32, u32)>,
     /// The last layer the pairs hold for; `None` before the first build and after the front
     /// changed (collapses, redirected columns).
@@ -228,11 +223,12 @@ fn trace_crossing_pairs(front: &Front, columns: &Columns, pairs: impl Iterator<I
 
 /// The pairs of triangles sharing a column but no edge where one of them changes shape this
 /// slab (a column of it stops while another moves, merges, or has a split on its edge), among
-/// the `suspects`, or whose columns point apart by more than [`TURNED`] (`turned`, from
-/// [`turned_pairs`]). A front moving as a whole cannot fold over a shared vertex without turning
-/// a cell between them inside out unless it turns sharply there (a hole a few edges round, whose
-/// fronts meet on its axis: flange); where columns stop at different layers or merge, thin
-/// triangles can, with every cell valid, so these pairs are tested beyond their shared vertex.
+/// the `suspects`, or whose columns point apart by more than
+/// [`TUNING.guard.turned`](super::tuning::Guard::turned) (`turned`, from [`turned_pairs`]). A front
+/// moving as a whole cannot fold over a shared vertex without turning a cell between them inside
+/// out unless it turns sharply there (a hole a few edges round, whose fronts meet on its axis:
+/// flange); where columns stop at different layers or merge, thin triangles can, with every cell
+/// valid, so these pairs are tested beyond their shared vertex.
 fn pairs_at_changes(
     plan: &SlabPlan,
     reshape: &Reshape,
@@ -272,12 +268,13 @@ fn pairs_at_changes(
 }
 
 /// The triangles `(f, g)` sharing one column (no edge) whose columns' summed directions make a
-/// cosine below [`TURNED`], seen from `f`, in the order of `f`.
+/// cosine below [`TUNING.guard.turned`](super::tuning::Guard::turned), seen from `f`, in the order
+/// of `f`.
 fn turned_pairs(front: &Front, columns: &Columns) -> Vec<(u32, u32)> {
     let direction = |f: usize| front.face_columns(f).iter().map(|&c| columns.dir[c as usize]).sum::<DVec3>();
     let turned = |f: usize, g: usize| {
         let (a, b) = (direction(f), direction(g));
-        a.dot(b) < TURNED * a.length() * b.length()
+        a.dot(b) < TUNING.guard.turned * a.length() * b.length()
     };
     (0..front.len())
         .into_par_iter()
@@ -450,9 +447,6 @@ pub(super) fn triangles_meet(t_ids: [u32; 3], t: [DVec3; 3], u_ids: [u32; 3], u:
     }
 }
 
-/// Apex heights tried for a pyramid on a front quad: half its shortest edge, then halved.
-const APEX_TRIES: i32 = 6;
-
 /// The centre of the quad `x` and its unit normal (across its diagonals, right-handed): where
 /// [`pyramid_apex`] stands a pyramid's apex over it.
 pub fn quad_frame(x: [DVec3; 4]) -> (DVec3, DVec3) {
@@ -466,12 +460,14 @@ pub fn quad_frame(x: [DVec3; 4]) -> (DVec3, DVec3) {
 pub fn pyramid_apex(x: [DVec3; 4]) -> Option<DVec3> {
     let (centre, normal) = quad_frame(x);
     let min_edge = (0..4).map(|i| x[i].distance(x[(i + 1) % 4])).fold(f64::INFINITY, f64::min);
-    (0..APEX_TRIES).map(|k| centre + normal * (0.5 * min_edge * 0.5f64.powi(k))).find(|&apex| {
-        let mut p = [DVec3::ZERO; 8];
-        p[..4].copy_from_slice(&x);
-        p[4] = apex;
-        cell_validity(CellKind::Pyramid, &p).is_valid()
-    })
+    (0..TUNING.pyramids.apex_tries).map(|k| centre + normal * (0.5 * min_edge * 0.5f64.powi(k))).find(
+        |&apex| {
+            let mut p = [DVec3::ZERO; 8];
+            p[..4].copy_from_slice(&x);
+            p[4] = apex;
+            cell_validity(CellKind::Pyramid, &p).is_valid()
+        },
+    )
 }
 
 #[cfg(test)]
@@ -512,7 +508,7 @@ mod tests {
                 let end: Vec<DVec3> = (0..6)
                     .map(|c| {
                         mesh.points[columns.node[c] as usize]
-                            + columns.dir[c] * (0.1 * LOOKAHEAD_LAYERS as f64)
+                            + columns.dir[c] * (0.1 * TUNING.guard.lookahead_layers as f64)
                     })
                     .collect();
                 guard.rebuild(
@@ -521,7 +517,7 @@ mod tests {
                     &mesh,
                     &columns,
                     &front,
-                    Reach { end, through_layer: k + LOOKAHEAD_LAYERS - 1 },
+                    Reach { end, through_layer: k + TUNING.guard.lookahead_layers - 1 },
                 );
             }
             let found = guard.crossings(&plan, &Reshape::default(), &mesh, &columns, &front, &[0, 1]);

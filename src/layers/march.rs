@@ -15,11 +15,12 @@ use rayon::prelude::*;
 use super::collapse::Merges;
 use super::entropy::VertexWalls;
 use super::front::{Columns, Front, NOT_MERGED};
-use super::guard::{CrossingGuard, Reach, LOOKAHEAD_LAYERS};
+use super::guard::{CrossingGuard, Reach};
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
 use super::slab_plan::{Reshape, SlabPlan};
 use super::split::{self, Adapt, Sizes, NONE};
 use super::swap::{self, SwapRole};
+use super::tuning::TUNING;
 use super::{bend, coarsen, entropy};
 use crate::geometry::DVec3;
 use crate::mesh::{CellKind, VolumeMesh};
@@ -487,7 +488,7 @@ fn front_sizes(points: &[DVec3], columns: &Columns, front: &Front) -> Vec<f64> {
         if columns.wall_vertex[a] == columns.wall_vertex[b] {
             1.0
         } else {
-            growth(a).min(growth(b)).powf(super::GRADING_SHARE)
+            growth(a).min(growth(b)).powf(TUNING.grading.growth_share)
         }
     };
     let neighbours = |c: usize, out: &mut Vec<usize>| {
@@ -519,7 +520,8 @@ fn ended_neighbour_layers(columns: &Columns, front: &Front) -> (Vec<u32>, Vec<u3
 
 /// Where every column will be at the end of the guard's horizon: after layer `k` if the slab
 /// has merged columns (they move to other columns' positions), else after the next
-/// [`LOOKAHEAD_LAYERS`] layers if it keeps moving (or its last layer, if that comes first).
+/// [`TUNING.guard.lookahead_layers`](super::tuning::Guard::lookahead_layers) layers if it keeps
+/// moving (or its last layer, if that comes first).
 fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach {
     let proposal = Proposal::of_plan(mesh, plan);
     let committed = proposal.committed;
@@ -528,7 +530,7 @@ fn reach(plan: &SlabPlan, mesh: &VolumeMesh, columns: &Columns, k: u32) -> Reach
             (0..columns.len() as u32).map(|c| proposal.position(plan.top(c, columns, committed))).collect();
         return Reach { end, through_layer: k };
     }
-    let last = k + LOOKAHEAD_LAYERS - 1;
+    let last = k + TUNING.guard.lookahead_layers - 1;
     let end = (0..columns.len())
         .into_par_iter()
         .map(|c| {
@@ -873,13 +875,6 @@ fn repair_invalid_cells(
     changed_anywhere
 }
 
-/// How steeply (thickness over wall distance) stacks may rise around a pit
-/// ([`grade_around_pits`]). Measured on the ONERA M6's tip (H = 1e-3 D, 10 layers, growth
-/// 1.1999 / 1.2 / 1.2001; without the cone 11/12/9 core tetrahedra below 10 deg, the worst
-/// 0.95 deg, coverage 99.85%): at slope 1, 1/6/1 below 10 deg and coverage 99.42%; at 2,
-/// 3/0/0 and 99.63%; at 3, 0/0/1 (worst 9.6 deg) and 99.74%; at 4, 5/6/7 (worst 3.2 deg).
-const PIT_SLOPE: f64 = 3.0;
-
 /// Stop the live columns whose wall vertex's stack is capped below layer `k` (`caps`, by wall
 /// vertex: the core could not fill around their tops, [`crate::pipeline`]); they count as
 /// pits of their thickness for [`grade_around_pits`]. Returns how many stopped.
@@ -955,9 +950,9 @@ fn stop_at_gaps(columns: &mut Columns, rooms: &[f64], k: u32) -> usize {
 /// Stacks that stopped with no layer leave a pit to the wall that the core fills with slivers
 /// (its walls are steep and narrow: the ONERA M6's wing tip). Around such a stack, and around
 /// the ones stopped for it, a stack stops before it rises above its neighbour's thickness by
-/// more than [`PIT_SLOPE`] times the distance between their wall points, so the pit opens into
-/// a cone. `pit` records the thickness of each stack stopped in a pit. Returns how many columns
-/// stopped.
+/// more than [`TUNING.grading.pit_slope`](super::tuning::Grading::pit_slope) times the distance
+/// between their wall points, so the pit opens into a cone. `pit` records the thickness of each
+/// stack stopped in a pit. Returns how many columns stopped.
 fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<f64>>, k: u32) -> usize {
     // Splits add columns as the front marches.
     pit.resize(columns.len(), None);
@@ -978,7 +973,7 @@ fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<
         for c in front.faces_of(n as u32).flat_map(|f| front.face_columns(f)) {
             let c = *c as usize;
             let Some(height) = columns.distance(c, k).filter(|_| columns.alive[c]) else { continue };
-            if height > h + PIT_SLOPE * columns.base[c].distance(columns.base[n]) {
+            if height > h + TUNING.grading.pit_slope * columns.base[c].distance(columns.base[n]) {
                 stop.push(c as u32);
             }
         }
@@ -1372,7 +1367,7 @@ mod tests {
         for i in 1..layers.len() {
             // The thickest stack within the slope over its neighbour towards the pit, or full.
             let thickness = |n: u32| spec.distance(n);
-            let below = thickness(layers[i - 1]) + PIT_SLOPE * STRIP_STEP;
+            let below = thickness(layers[i - 1]) + TUNING.grading.pit_slope * STRIP_STEP;
             let (l, rising) = (layers[i], thickness(layers[i]) <= below + 1e-12);
             assert!(rising && (l == 10 || thickness(l + 1) > below), "{layers:?}");
         }

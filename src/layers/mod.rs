@@ -18,6 +18,7 @@ pub mod sliding;
 pub mod smoothness;
 pub mod split;
 pub mod swap;
+pub mod tuning;
 pub mod unfold;
 
 use std::collections::HashMap;
@@ -31,6 +32,7 @@ use crate::normals::WallNormals;
 use crate::sizing::wall::mean_edge_length_per_vertex;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
+use tuning::TUNING;
 
 pub use march::MarchStats;
 pub use split::Adapt;
@@ -91,7 +93,7 @@ pub fn build_layers(
     let mut marched = start.march(&fitted, &mut on_layer);
     // Stacks stopped short where the first layer is too tall for the wall's facets: march
     // again with the first height fitted there (and graded around).
-    for _ in 0..REFITS {
+    for _ in 0..TUNING.first_layer.refits {
         let refit: Vec<u32> = stopped_too_tall_for_the_wall(surface, &marched)
             .into_iter()
             .filter(|&v| !fitted[v as usize])
@@ -179,9 +181,6 @@ pub fn build_layers(
         top_stacks,
     }
 }
-
-/// Marches again at most, each with the first height fitted at more wall vertices.
-const REFITS: usize = 2;
 
 /// What a march starts from: the wall, its normals and the patches' stacks.
 struct MarchStart<'a> {
@@ -333,9 +332,6 @@ fn lowered_first_heights(
     lowered
 }
 
-/// The share of the growth ratio (as an exponent) that neighbouring first heights may differ by.
-pub(crate) const GRADING_SHARE: f64 = 0.9;
-
 /// Where patches with different first heights meet, lower the larger ones near the border so
 /// that neighbouring wall vertices' first heights (and with equal counts and growth, their
 /// stack thicknesses) differ by at most the growth ratio: no step in the layers at a patch
@@ -371,7 +367,7 @@ fn grade_first_heights(surface: &Surface, columns: &front::Columns, column_spec:
     crate::sizing::graded_minimum(
         &mut height,
         |v, out| out.extend(neighbours[v].iter().map(|&w| w as usize)),
-        |v, w, h| h * growth[w].min(growth[v]).powf(GRADING_SHARE),
+        |v, w, h| h * growth[w].min(growth[v]).powf(TUNING.grading.growth_share),
     );
     for (c, spec) in column_spec.iter_mut().enumerate() {
         if let Some(s) = spec {

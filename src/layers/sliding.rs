@@ -12,6 +12,7 @@ use std::collections::{HashMap, HashSet};
 
 use spade::{AngleLimit, ConstrainedDelaunayTriangulation, Point2, RefinementParameters, Triangulation};
 
+use super::tuning::TUNING;
 use crate::geometry::DVec3;
 use crate::mesh::VolumeMesh;
 use crate::normals::constraint::Plane;
@@ -19,11 +20,6 @@ use crate::surface::Surface;
 
 /// A free face lies on a plane when its nodes are this close to it (fraction of body size).
 const ON_PLANE: f64 = 1e-9;
-/// Interior patch vertices closer to the new boundary than this fraction of the nearest
-/// boundary edge's length are left out of the new triangulation (they would make slivers).
-const CLEARANCE: f64 = 0.5;
-/// A bound on the points the refinement of a patch may add, per boundary edge.
-const MAX_ADDED_PER_EDGE: usize = 50;
 
 #[derive(Debug, thiserror::Error)]
 pub enum SlidingError {
@@ -312,7 +308,7 @@ fn refine(
         .keep_constraint_edges()
         .with_angle_limit(AngleLimit::from_deg(25.0))
         .with_max_allowed_area(max_area)
-        .with_max_additional_vertices(MAX_ADDED_PER_EDGE * boundary.len() + 1000);
+        .with_max_additional_vertices(TUNING.sliding.max_added_per_edge * boundary.len() + 1000);
     cdt.refine(parameters);
 }
 
@@ -320,13 +316,14 @@ fn triangle_area(points: &[DVec3], [a, b, c]: [u32; 3]) -> f64 {
     crate::geometry::triangle_area_vector(points[a as usize], points[b as usize], points[c as usize]).length()
 }
 
-/// Is `x` at least [`CLEARANCE`] edge lengths away from every boundary edge?
+/// Is `x` at least [`TUNING.sliding.clearance`](super::tuning::Sliding::clearance) edge lengths
+/// away from every boundary edge?
 fn clear_of(x: DVec3, boundary: &[(u32, u32)], points: &[DVec3]) -> bool {
     boundary.iter().all(|&(a, b)| {
         let (a, b) = (points[a as usize], points[b as usize]);
         let length = (b - a).length();
         let t = ((x - a).dot(b - a) / (length * length)).clamp(0.0, 1.0);
-        (a + (b - a) * t - x).length() >= CLEARANCE * length
+        (a + (b - a) * t - x).length() >= TUNING.sliding.clearance * length
     })
 }
 

@@ -6,7 +6,7 @@
 use serde::Serialize;
 
 use super::front::Columns;
-use super::split::SPLIT_LENGTH;
+use super::tuning::TUNING;
 use crate::surface::Surface;
 
 /// A distribution of ratios: quantiles, the largest, and the fraction within a tolerance band.
@@ -119,8 +119,16 @@ pub fn measure(
         patch_border_thickness_ratio: RatioStats::of(at_border, 1.0, growth * (1.0 + 1e-9)),
         layer_height_ratio: RatioStats::of(steps, 1.0 / growth - 1e-9, growth * (1.0 + 1e-9)),
         isotropy_ratio: RatioStats::of(isotropy, 1.0 / growth, growth),
-        front_edge_length: RatioStats::of(front_edges.0, 1.0 / SPLIT_LENGTH, SPLIT_LENGTH),
-        fan_edge_length: RatioStats::of(front_edges.1, 1.0 / SPLIT_LENGTH, SPLIT_LENGTH),
+        front_edge_length: RatioStats::of(
+            front_edges.0,
+            1.0 / TUNING.adaptation.split_length,
+            TUNING.adaptation.split_length,
+        ),
+        fan_edge_length: RatioStats::of(
+            front_edges.1,
+            1.0 / TUNING.adaptation.split_length,
+            TUNING.adaptation.split_length,
+        ),
     }
 }
 

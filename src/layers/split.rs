@@ -1,7 +1,9 @@
 //! Tangential split of front edges (tangential adaptivity): a front edge
-//! whose proposed top is longer than [`SPLIT_LENGTH`] in the metric gets a new column at its
-//! middle, born at this layer's top. Fan edges (two copies of one wall vertex) start with no
-//! length and open like the distance times the fan angle; splitting them keeps fans bounded.
+//! whose proposed top is longer than
+//! [`TUNING.adaptation.split_length`](super::tuning::Adaptation::split_length) in the metric gets a
+//! new column at its middle, born at this layer's top. Fan edges (two copies of one wall vertex)
+//! start with no length and open like the distance times the fan angle; splitting them keeps fans
+//! bounded.
 //!
 //! The new column has no bottom: in the slab being built, the lateral face over the split edge
 //! `(a, b)` is the pentagon `(a, b, tb, m, ta)`. It is cut into a quad and a triangle by a rule
@@ -11,14 +13,13 @@
 //! ([`super::slab::cell_from_faces`]). A split that would make an invalid cell is given up for
 //! the layer; a split whose ends do not both move on their own is not made.
 
-use std::f64::consts::SQRT_2;
-
 use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{ColumnStart, Columns, Front};
 use super::slab::{self, cell_from_faces, Merging, Polygon, SlabCell};
 use super::slab_plan::SlabPlan;
+use super::tuning::TUNING;
 use crate::sizing::SizingField;
 
 /// Whether, and to which sizes, the front's edges are split while it marches.
@@ -33,31 +34,8 @@ pub enum Adapt<'a> {
     Field(&'a SizingField),
 }
 
-/// A front edge longer than this in the metric is split.
-pub const SPLIT_LENGTH: f64 = SQRT_2;
-
-/// An edge between two wall columns is collapsed only once its size (target or wall length) has
-/// compressed to this fraction of its wall length (it is then below `COMPRESSED / sqrt 2` of it).
-/// Collapsed earlier, the columns merge while still far apart, and the twisted cells around
-/// them span several layers along the wall's normal: measure.py's resolution coverage at
-/// concave ridges (H = 1e-3 D, 10 layers) is, for 1 / 0.5 / 0.3 here and without collapses,
-/// flange 0.837 / 0.933 / 0.944 / 0.947, mech 0.41 / 0.63 / 0.64 / 0.61, fandisk 0.972 /
-/// 0.923 / 0.909 / 0.835.
-pub const COMPRESSED: f64 = 0.5;
-
-/// A front edge this many times shorter than its layer is high is collapsed
-/// ([`EdgeSizes::collapse_length`]). At 2, the ONERA M6's wing-tip cap (facets of 0.2-0.4 under a
-/// first layer of 1.67) coarsens: 574 core slivers -> 114, and the first core cells match the
-/// last layer at 99.0% of the front triangles (94.9% before); at 1.4, 58 slivers but the box's
-/// transition layers coarsen too (94.9% -> 93.5%).
-pub const TALLEST_CELL: f64 = 2.0;
-
 /// No split (in the per-edge split lists of a face).
 pub const NONE: u32 = u32::MAX;
-
-/// A new column's first top lies at least this fraction of its layer's height beyond the middle
-/// of its ends' tops.
-const SPLIT_LIFT: f64 = 0.02;
 
 /// The sizes the front's edges are measured against.
 ///
@@ -70,9 +48,10 @@ const SPLIT_LIFT: f64 = 0.02;
 /// long thin wall triangle is the user's mesh, not a front that grew): an edge between two wall
 /// columns is split only once it is longer than `sqrt(2)` times both the target and its own
 /// length on the wall, and collapsed only once shorter than `1/sqrt(2)` times both the target
-/// and [`COMPRESSED`] times its wall length. Fronts that
-/// widen (convex walls, fans, whose edges have no length on the wall) or compress (concave
-/// walls) and the user's own sizes (a sizing field's regions and maximum size) change it.
+/// and [`TUNING.adaptation.compressed`](super::tuning::Adaptation::compressed) times its wall
+/// length. Fronts that widen (convex walls, fans, whose edges have no length on the wall) or
+/// compress (concave walls) and the user's own sizes (a sizing field's regions and maximum size)
+/// change it.
 pub struct Sizes<'a> {
     pub adapt: Adapt<'a>,
     field: Option<&'a SizingField>,
@@ -248,15 +227,18 @@ impl EdgeSizes<'_> {
     }
 
     /// Length of front edge `e` between columns `a` and `b` against the size it is collapsed
-    /// at: the target, or [`COMPRESSED`] times the edge's length on the wall where that is
-    /// shorter; but an edge [`TALLEST_CELL`] times shorter than the layer's height is collapsed
-    /// anyway (not coarser than the user's size, though): a front finer than its layers are
-    /// high (a wall faceted finer than the first layer, as at a wing tip) makes needles, and
-    /// coarsens whether it compressed or not.
+    /// at: the target, or [`TUNING.adaptation.compressed`](super::tuning::Adaptation::compressed)
+    /// times the edge's length on the wall where that is shorter; but an edge
+    /// [`TUNING.adaptation.tallest_cell`](super::tuning::Adaptation::tallest_cell) times shorter
+    /// than the layer's height is collapsed anyway (not coarser than the user's size, though): a
+    /// front finer than its layers are high (a wall faceted finer than the first layer, as at a
+    /// wing tip) makes needles, and coarsens whether it compressed or not.
     pub fn collapse_length(&self, columns: &Columns, a: usize, b: usize, e: DVec3) -> f64 {
-        let on_wall = columns.wall_edge_length(a, b).map_or(f64::INFINITY, |w| COMPRESSED * w);
-        // Collapsed below 1/sqrt 2 of this size: once the layer is TALLEST_CELL times its width.
-        let by_height = mean_size(self.height, a, b) * std::f64::consts::SQRT_2 / TALLEST_CELL;
+        let on_wall =
+            columns.wall_edge_length(a, b).map_or(f64::INFINITY, |w| TUNING.adaptation.compressed * w);
+        // Collapsed below 1/sqrt 2 of this size: once the layer is `tallest_cell` times its width.
+        let by_height =
+            mean_size(self.height, a, b) * std::f64::consts::SQRT_2 / TUNING.adaptation.tallest_cell;
         let size = mean_size(self.target, a, b).min(on_wall).max(by_height.min(mean_size(self.user, a, b)));
         e.length() / size
     }
@@ -286,8 +268,9 @@ pub(super) fn propose(
                 let (a, b) = (cols[i], cols[(i + 1) % n]);
                 let (ua, ub) = (a as usize, b as usize);
                 let live = columns.alive[ua] && columns.alive[ub];
-                let long =
-                    live && limits.split_length(columns, ua, ub, proposed[ub] - proposed[ua]) > SPLIT_LENGTH;
+                let long = live
+                    && limits.split_length(columns, ua, ub, proposed[ub] - proposed[ua])
+                        > TUNING.adaptation.split_length;
                 long.then_some(([a.min(b), a.max(b)], f as u32, i as u8))
             })
         })
@@ -320,8 +303,9 @@ pub(super) fn propose(
 /// The column born at the middle of `edge` in layer `k`: from the middle of the arc between its
 /// ends' wall points (the wall vertex itself for a fan edge), along their mean direction at the
 /// scale [`Columns::scale_along`] gives, its top the middle of theirs pushed along that
-/// direction onto the layer's distance (by at least [`SPLIT_LIFT`] of the layer).
-/// `None` where the ends slide differently or point opposite ways.
+/// direction onto the layer's distance (by at least
+/// [`TUNING.adaptation.split_lift`](super::tuning::Adaptation::split_lift) of the layer). `None`
+/// where the ends slide differently or point opposite ways.
 fn new_column(
     columns: &Columns,
     proposed: &[DVec3],
@@ -340,7 +324,7 @@ fn new_column(
     let middle = 0.5 * (proposed[a] + proposed[b]);
     // Where the walls' offset is planar the middle already lies on it; a top left on the
     // chord would make the triangles over a collapsed edge flat, so it rises a little.
-    let lift = SPLIT_LIFT * columns.layer_height(a, k);
+    let lift = TUNING.adaptation.split_lift * columns.layer_height(a, k);
     let push = (scale * d - (middle - base).dot(dir)).max(lift);
     let top = columns.slide[a].project(middle + dir * push);
     Some(((base, dir, scale), top))
@@ -499,7 +483,7 @@ mod tests {
         let columns =
             Columns { base: vec![DVec3::ZERO, 0.3 * DVec3::X], born_at: vec![0, 0], ..Default::default() };
         let (e, target, unbounded) = (0.3 * DVec3::X, [0.3; 2], [f64::INFINITY; 2]);
-        let collapse = super::super::coarsen::COLLAPSE_LENGTH;
+        let collapse = TUNING.adaptation.collapse_length;
         let (thin, tall, user) = ([0.1; 2], [1.67; 2], [0.3; 2]);
         let thin_layer = EdgeSizes { target: &target, height: &thin, user: &unbounded };
         let tall_layer = EdgeSizes { target: &target, height: &tall, user: &unbounded };
@@ -507,7 +491,7 @@ mod tests {
         assert!(thin_layer.collapse_length(&columns, 0, 1, e) > collapse);
         assert!(tall_layer.collapse_length(&columns, 0, 1, e) < collapse);
         assert!(users_size.collapse_length(&columns, 0, 1, e) > collapse);
-        assert!(tall_layer.split_length(&columns, 0, 1, e) < SPLIT_LENGTH);
+        assert!(tall_layer.split_length(&columns, 0, 1, e) < TUNING.adaptation.split_length);
     }
 
     /// On a circle of radius 2 the middle of the arc between two points rises above their

@@ -21,12 +21,8 @@ use super::guard::triangles_meet;
 use super::slab::{self, cell_from_faces, Polygon, SlabCell};
 use super::slab_plan::SlabPlan;
 use super::split::Splits;
+use super::tuning::TUNING;
 use crate::geometry::triangle_min_angle;
-
-/// A pair is swapped only when its worst angle is below this (degrees)...
-const POOR_ANGLE: f64 = 30.0;
-/// ...and the swap raises it by at least this factor.
-const GAIN: f64 = 1.25;
 
 /// One swap: faces `f = (a, b, c)` and `g = (b, a, d)` become `(c, a, d)` and `(d, b, c)`.
 #[derive(Clone, Copy, Debug)]
@@ -133,7 +129,7 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
                     proposed[cols[0] as usize],
                     proposed[cols[1] as usize],
                     proposed[cols[2] as usize],
-                ) < POOR_ANGLE;
+                ) < TUNING.adaptation.swap_poor_angle;
             (0..if poor { 3 } else { 0 }).filter_map(move |i| {
                 let (a, b, c) = (cols[i], cols[(i + 1) % 3], cols[(i + 2) % 3]);
                 let g = opposite_face(front, f, a, b)?;
@@ -241,7 +237,9 @@ pub(super) fn turn_merged_tops(
         }
         let Some(tri) = after(f) else { continue };
         let on_ridge = tri.iter().all(|&c| carries[c as usize]) && !tri.iter().any(|&c| fan[c as usize]);
-        if !on_ridge || triangle_min_angle(at(tri[0]), at(tri[1]), at(tri[2])) >= POOR_ANGLE {
+        if !on_ridge
+            || triangle_min_angle(at(tri[0]), at(tri[1]), at(tri[2])) >= TUNING.adaptation.swap_poor_angle
+        {
             continue;
         }
         for i in 0..3 {
@@ -410,18 +408,19 @@ fn opposite_face(front: &Front, f: usize, a: u32, b: u32) -> Option<usize> {
 }
 
 /// For tops `[a, b, c, d]` of the pair `(a, b, c)`, `(b, a, d)`: the pair's worst angle when
-/// swapping to `(c, a, d)`, `(d, b, c)` is worth it (the worst is poor, rises by [`GAIN`], and
-/// the new triangles face the old pair's way), else `None`.
+/// swapping to `(c, a, d)`, `(d, b, c)` is worth it (the worst is poor, rises by
+/// [`TUNING.adaptation.swap_gain`](super::tuning::Adaptation::swap_gain), and the new triangles
+/// face the old pair's way), else `None`.
 fn gain([a, b, c, d]: [DVec3; 4]) -> Option<f64> {
     let old = triangle_min_angle(a, b, c).min(triangle_min_angle(b, a, d));
-    if old >= POOR_ANGLE {
+    if old >= TUNING.adaptation.swap_poor_angle {
         return None;
     }
     let new = triangle_min_angle(c, a, d).min(triangle_min_angle(d, b, c));
     let normal = (b - a).cross(c - a) + (a - b).cross(d - b);
     let (n1, n2) = ((a - c).cross(d - c), (b - d).cross(c - d));
     let facing = n1.dot(normal) > 0.0 && n2.dot(normal) > 0.0 && n1.dot(n2) > 0.5 * n1.length() * n2.length();
-    (facing && new > GAIN * old).then_some(old)
+    (facing && new > TUNING.adaptation.swap_gain * old).then_some(old)
 }
 
 /// The cell over a swapped pair with bottom nodes `bottom` and top nodes `top` of `[a, b, c, d]`

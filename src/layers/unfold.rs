@@ -10,7 +10,8 @@
 //! last is thinner), every cell at it stays valid (exact test), and the moved front crosses
 //! nothing (exact tests, moves undone until it does not). A stack at its full count ends on
 //! the exact offset and stays, but at a fold so sharp that every core tetrahedron on its edge
-//! would be a sliver ([`SLIVER_FOLD_ANGLE`]).
+//! would be a sliver
+//! ([`TUNING.unfolding.sliver_fold_angle`](super::tuning::Unfolding::sliver_fold_angle)).
 
 use std::collections::HashMap;
 
@@ -19,29 +20,13 @@ use rayon::prelude::*;
 
 use super::front::{Columns, Front, NOT_MERGED};
 use super::guard::pyramid_apex;
+use super::tuning::TUNING;
 use crate::geometry::{signed_turn_deg, triangle_max_angle};
 use crate::mesh::{sorted_edge, CellKind, VolumeMesh};
 use crate::normals::constraint::Slide;
 use crate::quality::validity::{cell_validity, gather};
 use crate::surface::topology::{group_by_key_with, opposite_vertex};
 use crate::surface::Surface;
-
-/// A front triangle whose largest angle is above this (degrees) is a cap...
-pub(super) const CAP_ANGLE: f64 = 160.0;
-/// ...and a front edge whose angle on the core's side is below this (degrees) a fold: the fill's
-/// tetrahedra at such an edge seldom all keep 10 degrees (20 here left spot 81 tetrahedra below
-/// 10 degrees, 40 leaves 59; at 60 the pulled-back tops cost the flange coverage).
-const FOLD_ANGLE: f64 = 40.0;
-/// A fold sharper than this (degrees) leaves every core tetrahedron at its edge below the core's
-/// sliver bound ([`crate::fill::improve::SLIVER_THRESHOLD`], 10 degrees): there the tops of
-/// full stacks are pulled back too (spot, H = 1e-3 D, 10 layers: its worst core tetrahedron,
-/// 3.7 degrees on a fold of that angle between stacks of 4 and 10 prisms, goes; 20 degrees
-/// here left more slivers on the ONERA M6's wing tip).
-const SLIVER_FOLD_ANGLE: f64 = 10.0;
-/// The parts of its last step a top may be pulled back by.
-const PULL_BACKS: [f64; 4] = [0.2, 0.4, 0.6, 0.8];
-/// Rounds over the defects (a move may make one beside it).
-const ROUNDS: usize = 3;
 
 /// What [`unfold_front`] did.
 #[derive(Clone, Debug, Default, serde::Serialize)]
@@ -175,7 +160,8 @@ impl CoreFront {
 
     /// Whether triangle `t` is a cap or on a fold.
     fn is_defect(&self, t: u32) -> bool {
-        self.cap_angle(t) > CAP_ANGLE || self.has_fold_sharper_than(t, FOLD_ANGLE)
+        self.cap_angle(t) > TUNING.unfolding.cap_angle
+            || self.has_fold_sharper_than(t, TUNING.unfolding.fold_angle)
     }
 
     /// Whether an edge of triangle `t` has an angle on the core's side below `angle` (degrees).
@@ -222,13 +208,13 @@ pub fn unfold_front(
     let sliver_top = |v: u32| tops.get(&v).is_some_and(|&c| at_sliver(c));
     let cells = cells_at(mesh, &tops);
     let mut moved: HashMap<u32, (DVec3, f64)> = HashMap::new();
-    for _ in 0..ROUNDS {
+    for _ in 0..TUNING.unfolding.rounds {
         let mut changed = false;
         for t in 0..core_front.triangles.len() as u32 {
             if !core_front.is_defect(t) && !core_front.triangles[t as usize].into_iter().any(sliver_top) {
                 continue;
             }
-            let forces_slivers = core_front.has_fold_sharper_than(t, SLIVER_FOLD_ANGLE);
+            let forces_slivers = core_front.has_fold_sharper_than(t, TUNING.unfolding.sliver_fold_angle);
             for v in core_front.triangles[t as usize] {
                 let Some(&c) = tops.get(&v) else { continue };
                 if ends_at_full_count(columns, c) && !forces_slivers && !at_sliver(c) {
@@ -277,8 +263,9 @@ fn final_front(front: &Front, columns: &Columns) -> (Vec<[u32; 3]>, Vec<[u32; 4]
 /// that did not merge (the others merged into it) and free to move anywhere. A stack that ends
 /// at its full count ends on the exact offset, which a pull-back would leave (a V groove's
 /// bisector tops by 15% of the thickness): such a top may move only where it is on a fold of
-/// `front` sharper than [`SLIVER_FOLD_ANGLE`] (and [`unfold_front`] moves it only for such a
-/// fold).
+/// `front` sharper than
+/// [`TUNING.unfolding.sliver_fold_angle`](super::tuning::Unfolding::sliver_fold_angle) (and
+/// [`unfold_front`] moves it only for such a fold).
 fn movable_tops(
     columns: &Columns,
     front: &CoreFront,
@@ -286,7 +273,7 @@ fn movable_tops(
 ) -> HashMap<u32, usize> {
     let mut on_sharp_fold = std::collections::HashSet::new();
     for t in 0..front.triangles.len() as u32 {
-        if front.has_fold_sharper_than(t, SLIVER_FOLD_ANGLE) {
+        if front.has_fold_sharper_than(t, TUNING.unfolding.sliver_fold_angle) {
             on_sharp_fold.extend(front.triangles[t as usize]);
         }
     }
@@ -340,7 +327,7 @@ fn best_pull_back(
 ) -> Option<f64> {
     let start = front.points[v as usize];
     let mut best = (front.quality_at(v) + 1.0, None);
-    for part in PULL_BACKS {
+    for part in TUNING.unfolding.pull_backs {
         let pull = part * columns.last_step[c];
         if !front.move_node(v, start - columns.dir[c] * pull) {
             continue;
@@ -438,9 +425,9 @@ mod tests {
         assert!((angle(DVec3::new(0.5, 1.0, -1.0)) - 225.0).abs() < 1e-6);
         // Folded back over the second one, nearly flat: a fold.
         let folded = pair(DVec3::new(0.5, -1.0, 0.05));
-        assert!(folded.core_angle([0, 1]) < FOLD_ANGLE);
+        assert!(folded.core_angle([0, 1]) < TUNING.unfolding.fold_angle);
         assert!(folded.is_defect(0) && folded.is_defect(1));
-        assert!(folded.quality_at(3) < FOLD_ANGLE);
+        assert!(folded.quality_at(3) < TUNING.unfolding.fold_angle);
     }
 
     /// A top whose cell turns invalid goes back even where nothing crosses: a neighbour's move
@@ -495,10 +482,10 @@ mod tests {
         };
         let sharp = lifted(5.0);
         assert!((sharp.core_angle([0, 1]) - 5.0).abs() < 1e-6);
-        assert!(sharp.is_defect(0) && sharp.has_fold_sharper_than(0, SLIVER_FOLD_ANGLE));
+        assert!(sharp.is_defect(0) && sharp.has_fold_sharper_than(0, TUNING.unfolding.sliver_fold_angle));
         let mild = lifted(30.0);
         assert!((mild.core_angle([0, 1]) - 30.0).abs() < 1e-6);
-        assert!(mild.is_defect(0) && !mild.has_fold_sharper_than(0, SLIVER_FOLD_ANGLE));
+        assert!(mild.is_defect(0) && !mild.has_fold_sharper_than(0, TUNING.unfolding.sliver_fold_angle));
     }
 
     /// A stack at its full count keeps its top (it ends on the exact offset), but one under a
@@ -531,7 +518,7 @@ mod tests {
         assert_eq!(front.defects(), 0);
         assert!(front.move_node(3, DVec3::new(0.5, 0.01, 0.0)));
         assert!(front.is_defect(0), "a 178-degree corner");
-        assert!(front.quality_at(3) < 180.0 - CAP_ANGLE);
+        assert!(front.quality_at(3) < 180.0 - TUNING.unfolding.cap_angle);
     }
 
     #[test]
