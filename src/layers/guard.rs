@@ -14,12 +14,13 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{Columns, Front};
+use super::reshape::Reshape;
 use super::slab::Polygon;
-use super::slab_plan::{Reshape, SlabPlan};
+use super::slab_plan::SlabPlan;
 use super::split::{self, NONE};
 use super::tuning::TUNING;
 use crate::geometry::grid::overlapping_pairs_where;
-use crate::geometry::intersect::{folds_over_shared_edge, meet_beyond_shared_vertex, triangles_intersect};
+use crate::geometry::intersect::triangles_meet;
 use crate::geometry::Aabb;
 use crate::mesh::{CellKind, VolumeMesh};
 use crate::quality::measures::quad_centre;
@@ -424,29 +425,6 @@ impl TopShape {
     }
 }
 
-/// Whether triangles `t` and `u` (node ids and points) meet elsewhere than in the vertices they
-/// share: see [`TopShape::crosses`].
-pub(super) fn triangles_meet(t_ids: [u32; 3], t: [DVec3; 3], u_ids: [u32; 3], u: [DVec3; 3]) -> bool {
-    let shared_in_u = t_ids.map(|v| u_ids.iter().position(|&w| w == v));
-    match shared_in_u.iter().filter(|s| s.is_some()).count() {
-        0 => triangles_intersect(t, u),
-        1 => {
-            let i = shared_in_u.iter().position(|s| s.is_some()).unwrap_or(0);
-            let j = shared_in_u[i].unwrap_or(0);
-            let (a, b) = (t[(i + 1) % 3], t[(i + 2) % 3]);
-            let (c, d) = (u[(j + 1) % 3], u[(j + 2) % 3]);
-            meet_beyond_shared_vertex(t[i], a, b, c, d)
-        }
-        2 => {
-            let lone_t = shared_in_u.iter().position(|s| s.is_none()).unwrap_or(0);
-            let lone_u = (0..3).find(|&k| !t_ids.contains(&u_ids[k])).unwrap_or(0);
-            let (v, w) = (t[(lone_t + 1) % 3], t[(lone_t + 2) % 3]);
-            folds_over_shared_edge(v, w, t[lone_t], u[lone_u])
-        }
-        _ => false,
-    }
-}
-
 /// The centre of the quad `x` and its unit normal (across its diagonals, right-handed): where
 /// [`pyramid_apex`] stands a pyramid's apex over it.
 pub fn quad_frame(x: [DVec3; 4]) -> (DVec3, DVec3) {
@@ -529,26 +507,5 @@ mod tests {
         }
         assert_eq!(guard.rebuilds, 1);
         assert_eq!(crossings, vec![vec![], vec![], vec![(0, 1)]]);
-    }
-
-    /// Triangles sharing a vertex meet beyond it only when one runs through the other; sharing an
-    /// edge, only when folded flat onto each other; sharing nothing, when they intersect.
-    #[test]
-    fn triangles_meet_beyond_what_they_share() {
-        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-        let t = [p(0.0, 0.0, 0.0), p(1.0, 0.0, 0.0), p(0.0, 1.0, 0.0)];
-        // Sharing vertex 0: lifted apart, then dipping through t.
-        let apart = [p(0.0, 0.0, 0.0), p(-1.0, 0.0, 0.5), p(0.0, -1.0, 0.5)];
-        let through = [p(0.0, 0.0, 0.0), p(0.5, 0.2, -0.5), p(0.2, 0.5, 0.5)];
-        assert!(!triangles_meet([0, 1, 2], t, [0, 3, 4], apart));
-        assert!(triangles_meet([0, 1, 2], t, [0, 3, 4], through));
-        // Sharing the edge (1, 2): across it, then folded onto t.
-        let across = [p(1.0, 0.0, 0.0), p(1.0, 1.0, 0.0), p(0.0, 1.0, 0.0)];
-        let folded = [p(1.0, 0.0, 0.0), p(0.2, 0.2, 0.0), p(0.0, 1.0, 0.0)];
-        assert!(!triangles_meet([0, 1, 2], t, [1, 5, 2], across));
-        assert!(triangles_meet([0, 1, 2], t, [1, 5, 2], folded));
-        // Nothing shared: a triangle piercing t.
-        let pierce = [p(0.2, 0.2, -1.0), p(0.3, 0.2, 1.0), p(0.2, 0.3, 1.0)];
-        assert!(triangles_meet([0, 1, 2], t, [6, 7, 8], pierce));
     }
 }

@@ -12,6 +12,7 @@ pub mod front;
 pub mod gap;
 pub mod guard;
 pub mod march;
+pub mod reshape;
 pub mod slab;
 pub mod slab_plan;
 pub mod sliding;

@@ -1,12 +1,10 @@
-//! The state of one slab while it is being decided: which columns move and where to, which
-//! merge ([`SlabPlan`]), and which front edges are split or swapped ([`Reshape`]). The march
-//! ([`super::march`]) builds them; the repairs and adaptations change them; the slab's cells
-//! are built from them once every cell is valid.
+//! The state of one slab while it is being decided: which columns move and where to, and which
+//! merge ([`SlabPlan`]; the front edges split or swapped are [`super::reshape::Reshape`]). The
+//! march ([`super::march`]) builds it; the repairs and adaptations change it; the slab's cells
+//! are built from it once every cell is valid.
 
 use super::collapse::Merges;
-use super::front::{Columns, Front};
-use super::split::Splits;
-use super::swap::Swaps;
+use super::front::Columns;
 use crate::geometry::DVec3;
 
 /// The decisions for one slab: which columns move, where to, and which merge.
@@ -107,39 +105,5 @@ impl SlabPlan {
             self.moving[m as usize] = false;
         }
         changed
-    }
-}
-
-/// The changes of the front's topology proposed for one slab (tangential adaptivity): splits
-/// of long edges and swaps of badly shaped pairs (the collapses are merges of the plan).
-#[derive(Clone, Debug, Default)]
-pub(super) struct Reshape {
-    pub splits: Splits,
-    pub swaps: Swaps,
-    /// The tangential size at every column's proposed top (evaluated once a slab: a sizing
-    /// field's size is a search over the wall).
-    pub target: Vec<f64>,
-}
-
-impl Reshape {
-    /// Give up the swap, else the splits, of invalid face `f`; returns the faces whose cells
-    /// change (none if it had neither).
-    pub(super) fn give_up(&mut self, f: usize, plan: &SlabPlan) -> Vec<usize> {
-        let swapped = self.swaps.give_up(f, plan);
-        if !swapped.is_empty() {
-            return swapped;
-        }
-        self.splits.give_up(f, plan)
-    }
-
-    /// The faces whose cells change with the columns `changed`: the faces around them, and both
-    /// faces of a swap with one of them (its face without that column turns back into a cell of
-    /// its own when the swap is no longer made).
-    pub(super) fn faces_around_columns(&self, front: &Front, changed: &[u32]) -> Vec<usize> {
-        let mut faces = front.faces_around_columns(changed);
-        faces.extend(self.swaps.faces_with_columns(changed));
-        faces.sort_unstable();
-        faces.dedup();
-        faces
     }
 }

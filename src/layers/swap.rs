@@ -17,11 +17,11 @@ use glam::DVec3;
 use rayon::prelude::*;
 
 use super::front::{Columns, Front, NOT_MERGED};
-use super::guard::triangles_meet;
 use super::slab::{self, cell_from_faces, Polygon, SlabCell};
 use super::slab_plan::SlabPlan;
 use super::split::Splits;
 use super::tuning::TUNING;
+use crate::geometry::intersect::triangles_meet;
 use crate::geometry::triangle_min_angle;
 
 /// One swap: faces `f = (a, b, c)` and `g = (b, a, d)` become `(c, a, d)` and `(d, b, c)`.
