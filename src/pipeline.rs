@@ -311,9 +311,9 @@ impl LayersAndCore<'_> {
     /// front, which a pulled-back top opens, and the stacks keep their layers), and where a
     /// sliver stays over tops freed before, with those stacks a layer lower: the core there had
     /// no room for a good tetrahedron (fronts meeting head on in a crevice, a crumpled front),
-    /// and one layer less gives it room. At most `peel_rounds` more marches, and none after
-    /// [`PEEL_PATIENCE`] rounds in a row that did not beat the best; the round with the fewest
-    /// slivers (then the best worst angle) is kept.
+    /// and one layer less gives it room. At most `peel_rounds` more marches, none after a round
+    /// without slivers, and none after [`PEEL_PATIENCE`] rounds in a row that did not beat the
+    /// best; the round with the fewest slivers (then the best worst angle) is kept.
     fn run_peeling(&self, timings: &mut Timings) -> Result<(Round, PeelStats), MeshError> {
         let mut caps = vec![u32::MAX; self.surface.points.len()];
         let mut at_slivers = vec![false; self.surface.points.len()];
@@ -373,12 +373,15 @@ impl LayersAndCore<'_> {
                 "core slivers"
             );
             marked_last = marked;
+            // A round without slivers leaves nothing to mend: later rounds could only lower more
+            // stacks or pull more tops back.
+            let clean = this.slivers.tets.is_empty();
             if best.as_ref().is_none_or(|b| this.slivers.better_than(&b.slivers)) {
                 stats.kept_round = round;
                 kept_caps = capped_now;
                 best = Some(this);
             }
-            if !next_differs || round - stats.kept_round >= PEEL_PATIENCE {
+            if clean || !next_differs || round - stats.kept_round >= PEEL_PATIENCE {
                 break;
             }
         }

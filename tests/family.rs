@@ -90,6 +90,12 @@ fn family_meshes_pass_the_checker_and_a_solver_on_every_seed() {
         let m = r.measures.as_ref().unwrap_or_else(|e| panic!("{} seed {}: {e}", r.family, r.seed));
         assert!(m.valid && m.conforming && m.volume_identity, "{}", describe(r));
         assert!(m.solver_rejection.is_none(), "{}: {:?}", describe(r), m.solver_rejection);
+        let rounds = &m.slivers_by_round;
+        assert!(
+            rounds.iter().rev().skip(1).all(|&n| n > 0),
+            "{}: peeling went on after a round without slivers: {rounds:?}",
+            describe(r)
+        );
     }
 }
 

@@ -44,6 +44,8 @@ pub struct Measures {
     pub skewness_max: f64,
     pub wall_edges_above_70: usize,
     pub wall_edges_above_85: usize,
+    /// Core tetrahedra below 10 deg after each peeling round (the first is the plain march's).
+    pub slivers_by_round: Vec<usize>,
 }
 
 /// The spec's first layer height as a fraction of the bounding-box diagonal.
@@ -89,6 +91,7 @@ pub fn run_seed(family: Family, seed: u64, fineness: f64) -> SeedResult {
             skewness_max: fv.skewness_max,
             wall_edges_above_70: wall.edges_above_70,
             wall_edges_above_85: wall.edges_above_85,
+            slivers_by_round: r.peel.slivers_by_round.clone(),
         }
     });
     SeedResult { family: family.name(), seed, triangles, seconds, measures }
