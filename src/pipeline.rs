@@ -346,7 +346,10 @@ impl LayersAndCore<'_> {
             };
             stats.slivers_by_round.push(this.slivers.tets.len());
             let front_nodes = this.layered.top_stacks.len() as f64;
-            let peelable = this.slivers.tets.len() as f64 <= PEEL_MAX_SLIVER_SHARE * front_nodes;
+            // A round without slivers leaves nothing to mend: later rounds could only lower more
+            // stacks or pull more tops back.
+            let clean = this.slivers.tets.is_empty();
+            let peelable = !clean && this.slivers.tets.len() as f64 <= PEEL_MAX_SLIVER_SHARE * front_nodes;
             let capped_now = caps.iter().filter(|&&c| c != u32::MAX).count();
             let (marked, mut lowered) = if peelable {
                 this.slivers.pull_back_or_lower(&this.layered, &mut at_slivers, &mut caps)
@@ -373,15 +376,12 @@ impl LayersAndCore<'_> {
                 "core slivers"
             );
             marked_last = marked;
-            // A round without slivers leaves nothing to mend: later rounds could only lower more
-            // stacks or pull more tops back.
-            let clean = this.slivers.tets.is_empty();
             if best.as_ref().is_none_or(|b| this.slivers.better_than(&b.slivers)) {
                 stats.kept_round = round;
                 kept_caps = capped_now;
                 best = Some(this);
             }
-            if clean || !next_differs || round - stats.kept_round >= PEEL_PATIENCE {
+            if !next_differs || round - stats.kept_round >= PEEL_PATIENCE {
                 break;
             }
         }
