@@ -1163,7 +1163,7 @@ fn try_merge_as(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::layers::front::ColumnStart;
+    use crate::layers::front::{ColumnStart, ColumnState};
 
     /// The ridge vertex 0 at the origin with one triangle `size` long on each wall: wall 1
     /// (y = 0, x > 0, normal +y) and wall 2 (x = 0, y > 0, normal +x).
@@ -1338,8 +1338,8 @@ mod tests {
         let plain = Columns::rising(&bottoms, Some(spec));
         // Two columns off the front, merged into ridge columns 1 and 2 in an earlier layer.
         let mut crease = Columns::rising(&[bottoms.clone(), vec![DVec3::Z; 2]].concat(), Some(spec));
-        crease.merged_into[13] = 1;
-        crease.merged_into[14] = 2;
+        crease.state[13] = ColumnState::MergedInto(1);
+        crease.state[14] = ColumnState::MergedInto(2);
         let merged = |columns: &Columns, gap: f64| {
             let mut tops: Vec<DVec3> = (0..columns.len()).map(|c| columns.base[c] + 0.1 * DVec3::Z).collect();
             tops[6] = DVec3::new(1.5, gap, 0.1);

@@ -18,24 +18,14 @@ pub struct Columns {
     pub scale: Vec<f64>,
     /// The mesh node the column is at now.
     pub node: Vec<u32>,
-    /// Still marching.
-    pub alive: Vec<bool>,
+    /// What the column is doing now: marching, or how it ended.
+    pub state: Vec<ColumnState>,
     /// Layers completed.
     pub layers: Vec<u32>,
     /// The wall vertex the column grows from.
     pub wall_vertex: Vec<u32>,
-    /// The column this one merged into at a collapse ([`NOT_MERGED`] if none).
-    pub merged_into: Vec<u32>,
     /// Where the column may go: its nodes are projected onto a patch plane when it slides.
     pub slide: Vec<Slide>,
-    /// For a column that ended its stack because its next cell would have been isotropic: its
-    /// last layer's height over the front's tangential size then; NaN for the others.
-    pub isotropic_ratio: Vec<f64>,
-    /// For those columns: the front's tangential size they ended at (NaN for the others).
-    pub isotropic_size: Vec<f64>,
-    /// Stopped where its next layer would leave less than its own height below the medial
-    /// surface of the gap it faces (the march's gap stop): as thick as the gap allows.
-    pub ended_at_gap: Vec<bool>,
     /// Length of the column's last step (its last layer's height along it).
     pub last_step: Vec<f64>,
     /// The ratio of a step to the one before that is farthest from 1 (0 before two steps).
@@ -67,8 +57,32 @@ pub struct ColumnStart {
     pub last_step: f64,
 }
 
-/// `Columns::merged_into` of a column that has not merged.
-pub const NOT_MERGED: u32 = u32::MAX;
+/// What a column is doing now. A column starts [`Marching`](ColumnState::Marching) and leaves
+/// that state once, for one of the others, which it keeps: a column that stopped or merged
+/// never marches again, and only a marching column merges.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ColumnState {
+    /// Still marching: it gets the next layer unless the slab stops or merges it.
+    Marching,
+    /// Its stack ended: complete, capped, stopped by a repair or around a pit, or never started
+    /// (no layers, or held fixed on the wall).
+    Stopped {
+        /// Stopped where its next layer would leave less than its own height below the medial
+        /// surface of the gap it faces (the march's gap stop): as thick as the gap allows.
+        at_gap: bool,
+    },
+    /// Its stack ended because its next cell would have been isotropic: a complete stack, which
+    /// its neighbours' stacks step down to.
+    EndedIsotropic {
+        /// Its last layer's height over the front's tangential size then.
+        ratio: f64,
+        /// The front's tangential size it ended at, which its neighbours' sizes are graded from.
+        size: f64,
+    },
+    /// Merged into this column at a collapse, which carries its stack on (and may itself have
+    /// merged since, see [`Columns::carrier`]).
+    MergedInto(u32),
+}
 
 #[cfg(test)]
 impl Columns {
@@ -113,14 +127,10 @@ impl Columns {
         self.dir.push(start.dir);
         self.scale.push(start.scale);
         self.node.push(start.node);
-        self.alive.push(true);
+        self.state.push(ColumnState::Marching);
         self.layers.push(start.layers);
         self.wall_vertex.push(start.wall_vertex);
-        self.merged_into.push(NOT_MERGED);
         self.slide.push(start.slide);
-        self.isotropic_ratio.push(f64::NAN);
-        self.isotropic_size.push(f64::NAN);
-        self.ended_at_gap.push(false);
         self.last_step.push(start.last_step);
         self.max_step_ratio.push(0.0);
         self.spec.push(start.spec);
@@ -189,10 +199,63 @@ impl Columns {
 
     /// The column that carries `c` on: itself, or the last one of its chain of merges.
     pub fn carrier(&self, mut c: usize) -> usize {
-        while self.merged_into[c] != NOT_MERGED {
-            c = self.merged_into[c] as usize;
+        while let Some(r) = self.merged_into(c) {
+            c = r as usize;
         }
         c
+    }
+
+    /// Whether column `c` is still marching.
+    pub fn is_marching(&self, c: usize) -> bool {
+        self.state[c] == ColumnState::Marching
+    }
+
+    /// Whether each column is still marching.
+    pub fn marching(&self) -> Vec<bool> {
+        (0..self.len()).map(|c| self.is_marching(c)).collect()
+    }
+
+    /// Stop column `c` if it is marching (a column that has ended or merged stays so).
+    pub fn stop(&mut self, c: usize) {
+        if self.is_marching(c) {
+            self.state[c] = ColumnState::Stopped { at_gap: false };
+        }
+    }
+
+    /// The column `c` merged into at a collapse, if it did.
+    pub fn merged_into(&self, c: usize) -> Option<u32> {
+        match self.state[c] {
+            ColumnState::MergedInto(r) => Some(r),
+            _ => None,
+        }
+    }
+
+    /// Whether column `c`'s stack ended at isotropy (a complete stack, even before its full
+    /// count).
+    pub fn ended_isotropic(&self, c: usize) -> bool {
+        matches!(self.state[c], ColumnState::EndedIsotropic { .. })
+    }
+
+    /// The last layer's height over the front's tangential size of a column whose stack ended at
+    /// isotropy.
+    pub fn isotropic_ratio(&self, c: usize) -> Option<f64> {
+        match self.state[c] {
+            ColumnState::EndedIsotropic { ratio, .. } => Some(ratio),
+            _ => None,
+        }
+    }
+
+    /// The front's tangential size a column whose stack ended at isotropy ended at.
+    pub fn isotropic_size(&self, c: usize) -> Option<f64> {
+        match self.state[c] {
+            ColumnState::EndedIsotropic { size, .. } => Some(size),
+            _ => None,
+        }
+    }
+
+    /// Whether column `c` stopped at the medial surface of a gap ([`ColumnState::Stopped`]).
+    pub fn ended_at_gap(&self, c: usize) -> bool {
+        self.state[c] == ColumnState::Stopped { at_gap: true }
     }
 
     /// The extrusion scale of a column along `dir` born between columns `a` and `b` (a split

@@ -48,7 +48,7 @@ pub fn gap_limited(
         .filter(|&c| is_stopped[columns.wall_vertex[c] as usize] && stopped_early(columns, c))
         .map(|c| {
             let v = columns.wall_vertex[c] as usize;
-            let planned = columns.ended_at_gap[columns.carrier(c)];
+            let planned = columns.ended_at_gap(columns.carrier(c));
             let limited = planned || {
                 let edges = wall_edges_at(surface, topology, v as u32);
                 reaches_medial_surface(surface, &bvh, columns, points, c, &edges)
@@ -72,9 +72,7 @@ fn wall_edges_at(surface: &Surface, topology: &Topology, v: u32) -> Vec<DVec3> {
 /// Whether column `c` (or the column it merged into) has fewer layers than its full count.
 fn stopped_early(columns: &Columns, c: usize) -> bool {
     let carrier = columns.carrier(c);
-    columns
-        .full_count(c)
-        .is_some_and(|t| columns.layers[carrier] < t && columns.isotropic_ratio[carrier].is_nan())
+    columns.full_count(c).is_some_and(|t| columns.layers[carrier] < t && !columns.ended_isotropic(carrier))
 }
 
 /// Whether the stack of column `c` ends within one layer of the medial surface of a gap

@@ -467,10 +467,9 @@ mod tests {
             columns.dir.push(if i < 3 { DVec3::Z } else { -DVec3::Z });
             columns.scale.push(1.0);
             columns.node.push(i as u32);
-            columns.alive.push(true);
+            columns.state.push(crate::layers::front::ColumnState::Marching);
             columns.layers.push(0);
             columns.wall_vertex.push(i as u32);
-            columns.merged_into.push(crate::layers::front::NOT_MERGED);
         }
         let mut front = Front::default();
         front.push(&[0, 1, 2], 0, None);

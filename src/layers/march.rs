@@ -14,7 +14,7 @@ use rayon::prelude::*;
 
 use super::collapse::Merges;
 use super::entropy::VertexWalls;
-use super::front::{Columns, Front, NOT_MERGED};
+use super::front::{ColumnState, Columns, Front};
 use super::guard::{CrossingGuard, Reach};
 use super::reshape::Reshape;
 use super::slab::{slab_cell, Merging, Polygon, SlabCell};
@@ -298,7 +298,7 @@ fn cell_of_face(
 /// `mesh`. `columns.distance(c, k)` is how far column `c` should be from the wall after `k`
 /// layers, or `None` when its stack is complete. Columns that stop when isotropic also end their
 /// stack before the first layer whose height would reach the front's edge length around them
-/// (`count = "auto"`); they are marked in `columns.isotropic_ratio`. Unless `sizes.adapt` is
+/// (`count = "auto"`); they end as [`ColumnState::EndedIsotropic`]. Unless `sizes.adapt` is
 /// off, front edges
 /// that grow too long for `sizes` are split ([`super::split`]), which adds columns. `caps` holds
 /// the most layers of every wall vertex's stack ([`stop_at_caps`]).
@@ -320,8 +320,8 @@ pub fn march(
     for k in 1..=max_layers {
         let _layer = tracing::debug_span!("layer", k).entered();
         for c in 0..columns.len() {
-            if columns.alive[c] && columns.distance(c, k).is_none() {
-                columns.alive[c] = false;
+            if columns.distance(c, k).is_none() {
+                columns.stop(c);
             }
         }
         stats.columns_stopped_at_caps += stop_at_caps(columns, caps, &mut pit, k);
@@ -332,7 +332,7 @@ pub fn march(
             let wall_size = matches!(sizes.adapt, Adapt::Off).then_some(sizes.wall.as_slice());
             stop_isotropic_columns(mesh, columns, front, k, wall_size);
         }
-        if !columns.alive.iter().any(|&a| a) {
+        if !columns.state.contains(&ColumnState::Marching) {
             break;
         }
         columns.index_shared_nodes();
@@ -340,7 +340,7 @@ pub fn march(
         let mut proposed: Vec<DVec3> = (0..columns.len())
             .into_par_iter()
             .map(|c| match (columns.distance(c, k), columns.distance(c, k - 1)) {
-                (Some(d), Some(d_before)) if columns.alive[c] => columns.slide[c].project(
+                (Some(d), Some(d_before)) if columns.is_marching(c) => columns.slide[c].project(
                     points[columns.node[c] as usize] + columns.dir[c] * (columns.scale[c] * (d - d_before)),
                 ),
                 _ => DVec3::ZERO,
@@ -349,7 +349,7 @@ pub fn march(
         let reshape = match sizes.adapt {
             Adapt::Off => Reshape::default(),
             Adapt::Wall | Adapt::Field(_) => {
-                let target = sizes.tangential(&proposed, &columns.alive);
+                let target = sizes.tangential(&proposed, &columns.marching());
                 let splits = split::propose(columns, front, &proposed, k, sizes, &target);
                 let swaps = swap::propose(columns, front, &proposed, &splits);
                 Reshape { splits, swaps, target }
@@ -359,7 +359,7 @@ pub fn march(
         let (plan, reshape) =
             settle_slab_keeping_layers(mesh, columns, front, proposed, reshape, sizes, walls, &mut guard, k);
         stats.columns_stopped_early +=
-            columns.alive.iter().zip(&plan.moving).filter(|(a, m)| **a && !**m).count();
+            (0..columns.len()).filter(|&c| columns.is_marching(c) && !plan.moving[c]).count();
         stats.collapses += plan.collapses - plan.coarsened.len();
         stats.tangential_collapses += plan.coarsened.len();
         stats.flat_top_collapses += plan.flat_tops;
@@ -401,7 +401,7 @@ fn stop_crushed_transition(plan: &mut SlabPlan, columns: &Columns, crushed: &[(u
     ending.sort_unstable();
     ending.dedup();
     let fans = (0..columns.len() as u32).filter(|&c| {
-        columns.alive[c as usize] && ending.binary_search(&columns.wall_vertex[c as usize]).is_ok()
+        columns.is_marching(c as usize) && ending.binary_search(&columns.wall_vertex[c as usize]).is_ok()
     });
     plan.stop_all(fans).len()
 }
@@ -436,7 +436,7 @@ fn stop_isotropic_columns(
         cliff || d - d_before >= wall_size.map_or(size[c], |w| size[c].min(w[c]))
     };
     let candidates: Vec<bool> =
-        (0..columns.len()).map(|c| columns.alive[c] && columns.stops_when_isotropic(c, k)).collect();
+        (0..columns.len()).map(|c| columns.is_marching(c) && columns.stops_when_isotropic(c, k)).collect();
     // The columns of one wall vertex (a fan) end together: a fan strip cell with one side
     // stopped and the other moving would be flat.
     let mut vertex_ends = vec![false; columns.wall_vertex_count()];
@@ -445,17 +445,16 @@ fn stop_isotropic_columns(
     }
     for c in 0..columns.len() {
         if candidates[c] && vertex_ends[columns.wall_vertex[c] as usize] {
-            columns.alive[c] = false;
             // The last layer built, against the tangential size it ended at.
             let (d_before, d_last) = (
                 columns.distance(c, k - 1).unwrap_or(0.0),
                 k.checked_sub(2).and_then(|j| columns.distance(c, j)),
             );
-            columns.isotropic_ratio[c] = (d_before - d_last.unwrap_or(0.0)) / size[c];
+            let ratio = (d_before - d_last.unwrap_or(0.0)) / size[c];
             // What its neighbours are graded from: no more than the layer it did not build (a
             // column may end with its wall vertex's others before its own size says so).
             let refused = columns.distance(c, k).map_or(size[c], |d| d - d_before);
-            columns.isotropic_size[c] = size[c].min(refused);
+            columns.state[c] = ColumnState::EndedIsotropic { ratio, size: size[c].min(refused) };
         }
     }
 }
@@ -466,8 +465,8 @@ fn stop_isotropic_columns(
 /// wall vertex, which end together, share the smallest of their sizes.
 fn front_sizes(points: &[DVec3], columns: &Columns, front: &Front) -> Vec<f64> {
     let mut size = front.mean_edge_length_at_columns(points, columns);
-    for (s, &ended) in size.iter_mut().zip(&columns.isotropic_size) {
-        if !ended.is_nan() {
+    for (c, s) in size.iter_mut().enumerate() {
+        if let Some(ended) = columns.isotropic_size(c) {
             *s = ended;
         }
     }
@@ -509,10 +508,12 @@ fn ended_neighbour_layers(columns: &Columns, front: &Front) -> (Vec<u32>, Vec<u3
     for (a, b) in front.edges() {
         for (c, n) in [(a, b), (b, a)] {
             let n = columns.carrier(n);
-            if !columns.isotropic_ratio[n].is_nan() {
-                isotropic[c] = isotropic[c].min(columns.layers[n]);
-            } else if !columns.alive[n] && columns.spec[n].is_some() {
-                stopped[c] = stopped[c].min(columns.layers[n]);
+            match columns.state[n] {
+                ColumnState::EndedIsotropic { .. } => isotropic[c] = isotropic[c].min(columns.layers[n]),
+                ColumnState::Stopped { .. } if columns.spec[n].is_some() => {
+                    stopped[c] = stopped[c].min(columns.layers[n])
+                }
+                _ => {}
             }
         }
     }
@@ -589,7 +590,7 @@ fn settle_slab_keeping_layers(
             k,
             &vetoed,
         );
-        let stops = (0..columns.len()).filter(|&c| columns.alive[c] && !plan.moving[c]).count();
+        let stops = (0..columns.len()).filter(|&c| columns.is_marching(c) && !plan.moving[c]).count();
         let uncrossed = |c: u32| plan.uncrossed.contains(&c);
         let blamed: Vec<(u32, u32)> =
             plan.coarsened.iter().copied().filter(|&(a, b)| uncrossed(a) || uncrossed(b)).collect();
@@ -631,12 +632,12 @@ fn settle_slab(
     k: u32,
     vetoed: &[(u32, u32)],
 ) -> SlabPlan {
-    let mut plan = SlabPlan::new(columns.alive.clone(), proposed);
+    let mut plan = SlabPlan::new(columns.marching(), proposed);
     {
         let invalid_cells =
             |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
         if !matches!(sizes.adapt, Adapt::Off) {
-            let user = sizes.user(&plan.proposed, &columns.alive);
+            let user = sizes.user(&plan.proposed, &columns.marching());
             let limits = (&reshape.target[..], &user[..], k);
             let coarsening =
                 coarsen::collapse_short_edges(&mut plan, front, columns, limits, vetoed, |plan, group| {
@@ -884,8 +885,8 @@ fn stop_at_caps(columns: &mut Columns, caps: &[u32], pit: &mut Vec<Option<f64>>,
     let mut stopped = 0;
     for (c, depth) in pit.iter_mut().enumerate() {
         let capped = caps.get(columns.wall_vertex[c] as usize).is_some_and(|&cap| cap < k);
-        if columns.alive[c] && capped {
-            columns.alive[c] = false;
+        if columns.is_marching(c) && capped {
+            columns.stop(c);
             *depth = Some(columns.distance(c, k - 1).unwrap_or(0.0));
             stopped += 1;
         }
@@ -933,15 +934,14 @@ fn stop_at_gaps(columns: &mut Columns, rooms: &[f64], k: u32) -> usize {
             (Some(d), Some(d_before)) => rooms[c] - d < d - d_before,
             _ => false,
         };
-        if columns.alive[c] && close {
+        if columns.is_marching(c) && close {
             vertex_ends[columns.wall_vertex[c] as usize] = true;
         }
     }
     let mut stopped = 0;
     for c in 0..columns.len() {
-        if columns.alive[c] && vertex_ends[columns.wall_vertex[c] as usize] {
-            columns.alive[c] = false;
-            columns.ended_at_gap[c] = true;
+        if columns.is_marching(c) && vertex_ends[columns.wall_vertex[c] as usize] {
+            columns.state[c] = ColumnState::Stopped { at_gap: true };
             stopped += 1;
         }
     }
@@ -959,11 +959,9 @@ fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<
     pit.resize(columns.len(), None);
     for (c, depth) in pit.iter_mut().enumerate() {
         // Stopped with no layer: not merged on, not held by the wall, not ended at isotropy.
-        let stopped = !columns.alive[c]
-            && columns.merged_into[c] == NOT_MERGED
+        let stopped = matches!(columns.state[c], ColumnState::Stopped { .. })
             && columns.spec[c].is_some()
-            && columns.slide[c] != Slide::Fixed
-            && columns.isotropic_ratio[c].is_nan();
+            && columns.slide[c] != Slide::Fixed;
         if depth.is_none() && stopped && columns.layers[c] == 0 {
             *depth = Some(0.0);
         }
@@ -973,7 +971,7 @@ fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<
     for (n, h) in pit.iter().enumerate().filter_map(|(n, h)| Some((n, (*h)?))) {
         for c in front.faces_of(n as u32).flat_map(|f| front.face_columns(f)) {
             let c = *c as usize;
-            let Some(height) = columns.distance(c, k).filter(|_| columns.alive[c]) else { continue };
+            let Some(height) = columns.distance(c, k).filter(|_| columns.is_marching(c)) else { continue };
             if height > h + TUNING.grading.pit_slope * columns.base[c].distance(columns.base[n]) {
                 stop.push(c as u32);
             }
@@ -982,7 +980,7 @@ fn grade_around_pits(columns: &mut Columns, front: &Front, pit: &mut Vec<Option<
     stop.sort_unstable();
     stop.dedup();
     for &c in &stop {
-        columns.alive[c as usize] = false;
+        columns.stop(c as usize);
         pit[c as usize] = Some(columns.distance(c as usize, k - 1).unwrap_or(0.0));
     }
     stop.len()
@@ -1239,10 +1237,9 @@ fn commit_slab(
     for c in 0..columns.len() {
         let r = plan.merges.root(c as u32) as usize;
         if !plan.moving[r] {
-            columns.alive[c] = false;
+            columns.stop(c);
         } else if r != c {
-            columns.alive[c] = false;
-            columns.merged_into[c] = r as u32;
+            columns.state[c] = ColumnState::MergedInto(r as u32);
             columns.node[c] = top[c];
         } else {
             record_step(
@@ -1341,21 +1338,21 @@ mod tests {
             front.push(&[b, d, c], 0, None);
         }
         front.index_columns(columns.len());
-        columns.alive = vec![true; 16];
         let mut pit = Vec::new();
         for k in 1..=10 {
             if k == first_stop + 1 {
                 for c in [0, 1] {
-                    columns.alive[c] = false;
-                    if isotropic {
-                        columns.isotropic_ratio[c] = 1.0;
-                    }
+                    columns.state[c] = if isotropic {
+                        ColumnState::EndedIsotropic { ratio: 1.0, size: STRIP_STEP }
+                    } else {
+                        ColumnState::Stopped { at_gap: false }
+                    };
                 }
             }
             stop_at_caps(&mut columns, caps, &mut pit, k);
             grade_around_pits(&mut columns, &front, &mut pit, k);
             for c in 0..16 {
-                columns.layers[c] += u32::from(columns.alive[c]);
+                columns.layers[c] += u32::from(columns.is_marching(c));
             }
         }
         (0..8).map(|i| columns.layers[2 * i]).collect()

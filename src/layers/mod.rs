@@ -135,7 +135,7 @@ pub fn build_layers(
             let carrier = columns.carrier(c);
             let reached = columns.layers[carrier];
             // A stack ended at isotropy is complete (even before its full count).
-            let t = if columns.isotropic_ratio[carrier].is_nan() { t } else { reached.min(t) };
+            let t = if columns.ended_isotropic(carrier) { reached.min(t) } else { t };
             vertex_layers[v] = Some(vertex_layers[v].map_or(reached, |l| l.min(reached)));
             vertex_target[v] = Some(vertex_target[v].map_or(t, |x| x.max(t)));
             if let Some(d) = columns.distance(c, t) {
@@ -220,7 +220,9 @@ impl<'a> MarchStart<'a> {
         let lowered_first_heights = lowered_first_heights(&columns, &requested, &column_spec);
         columns.spec = column_spec;
         for c in 0..columns.len() {
-            columns.alive[c] = columns.spec[c].is_some() && columns.slide[c] != Slide::Fixed;
+            if columns.spec[c].is_none() || columns.slide[c] == Slide::Fixed {
+                columns.stop(c);
+            }
         }
         let max_layers = (0..columns.len()).filter_map(|c| columns.target(c)).max().unwrap_or(0);
         let mut mesh = VolumeMesh {
@@ -257,8 +259,7 @@ fn stopped_too_tall_for_the_wall(surface: &Surface, marched: &Marched) -> Vec<u3
             let Some(spec) = columns.spec[c] else { return false };
             // A stack ended at isotropy is complete.
             let carrier = columns.carrier(c);
-            let short =
-                columns.layers[carrier] < spec.full_count() && columns.isotropic_ratio[carrier].is_nan();
+            let short = columns.layers[carrier] < spec.full_count() && !columns.ended_isotropic(carrier);
             short && spec.first_aspect * spec.first_height > size[columns.wall_vertex[c] as usize]
         })
         .map(|c| columns.wall_vertex[c])

@@ -113,7 +113,7 @@ pub fn measure(
         edges.iter().filter(|e| border[e[0] as usize] || border[e[1] as usize]).filter_map(ratio).collect();
     let steps: Vec<f64> =
         (0..columns.len()).map(|c| columns.max_step_ratio[c]).filter(|&r| r > 0.0).collect();
-    let isotropy: Vec<f64> = columns.isotropic_ratio.iter().copied().filter(|r| !r.is_nan()).collect();
+    let isotropy: Vec<f64> = (0..columns.len()).filter_map(|c| columns.isotropic_ratio(c)).collect();
     Smoothness {
         neighbour_thickness_ratio: RatioStats::of(neighbour, 1.0, growth * (1.0 + 1e-9)),
         patch_border_thickness_ratio: RatioStats::of(at_border, 1.0, growth * (1.0 + 1e-9)),

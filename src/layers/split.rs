@@ -256,7 +256,7 @@ pub(super) fn propose(
     sizes: &Sizes,
     h: &[f64],
 ) -> Splits {
-    let user = sizes.user(proposed, &columns.alive);
+    let user = sizes.user(proposed, &columns.marching());
     let height: Vec<f64> = (0..columns.len()).map(|c| columns.layer_height(c, k)).collect();
     let mut long: Vec<([u32; 2], u32, u8)> = (0..front.len())
         .into_par_iter()
@@ -267,7 +267,7 @@ pub(super) fn propose(
             (0..n).filter_map(move |i| {
                 let (a, b) = (cols[i], cols[(i + 1) % n]);
                 let (ua, ub) = (a as usize, b as usize);
-                let live = columns.alive[ua] && columns.alive[ub];
+                let live = columns.is_marching(ua) && columns.is_marching(ub);
                 let long = live
                     && limits.split_length(columns, ua, ub, proposed[ub] - proposed[ua])
                         > TUNING.adaptation.split_length;

@@ -16,7 +16,7 @@
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::front::{Columns, Front, NOT_MERGED};
+use super::front::{Columns, Front};
 use super::slab::{self, cell_from_faces, Polygon, SlabCell};
 use super::slab_plan::SlabPlan;
 use super::split::Splits;
@@ -121,7 +121,7 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
         .flat_map_iter(|f| {
             let cols = front.face_columns(f);
             let looked_at =
-                cols.len() == 3 && !split_faces[f] && cols.iter().all(|&c| columns.alive[c as usize]);
+                cols.len() == 3 && !split_faces[f] && cols.iter().all(|&c| columns.is_marching(c as usize));
             // A pair gains only when one of its triangles is poor: most faces stop here (a pair
             // is looked at from its poor face, so from both when both are).
             let poor = looked_at
@@ -140,7 +140,7 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
                 let &d = other.iter().find(|&&x| x != a && x != b)?;
                 let four = [a, b, c, d];
                 let usable = |x: u32| {
-                    columns.alive[x as usize] && columns.slide[x as usize] == columns.slide[a as usize]
+                    columns.is_marching(x as usize) && columns.slide[x as usize] == columns.slide[a as usize]
                 };
                 if !four.iter().all(|&x| usable(x)) || c == d || front.are_neighbours(c, d) {
                     return None;
@@ -354,7 +354,7 @@ fn cell_faces(cell: &SlabCell) -> Option<Vec<Polygon>> {
 /// Whether each column carries a column merged into it in an earlier slab.
 pub(super) fn carrying_merged(columns: &Columns) -> Vec<bool> {
     let mut carries = vec![false; columns.len()];
-    for &r in columns.merged_into.iter().filter(|&&r| r != NOT_MERGED) {
+    for r in (0..columns.len()).filter_map(|c| columns.merged_into(c)) {
         carries[r as usize] = true;
     }
     carries

@@ -3,10 +3,10 @@
 //! [`Tuning`] and grouped by the stage of the march that reads them. The code reads them from
 //! [`TUNING`].
 //!
-//! What is not a choice stays beside its use: sentinels ([`super::front::NOT_MERGED`],
-//! [`super::split::NONE`]), names and zones ([`super::TOP_PATCH`], [`super::LAYER_ZONE_NAME`],
-//! [`super::march::LAYER_ZONE`]), array lengths ([`super::smoothness::HISTOGRAM_BINS`]) and the
-//! floating-point tolerance of the sliding patches' plane test.
+//! What is not a choice stays beside its use: sentinels ([`super::split::NONE`]), names and
+//! zones ([`super::TOP_PATCH`], [`super::LAYER_ZONE_NAME`], [`super::march::LAYER_ZONE`]), array
+//! lengths ([`super::smoothness::HISTOGRAM_BINS`]) and the floating-point tolerance of the
+//! sliding patches' plane test.
 
 use std::f64::consts::{FRAC_1_SQRT_2, SQRT_2};
 

@@ -18,7 +18,7 @@ use std::collections::HashMap;
 use glam::DVec3;
 use rayon::prelude::*;
 
-use super::front::{Columns, Front, NOT_MERGED};
+use super::front::{Columns, Front};
 use super::guard::pyramid_apex;
 use super::tuning::TUNING;
 use crate::geometry::{signed_turn_deg, triangle_max_angle};
@@ -278,7 +278,7 @@ fn movable_tops(
         }
     }
     let mut ending: HashMap<u32, Vec<usize>> = HashMap::new();
-    for c in (0..columns.len()).filter(|&c| columns.merged_into[c] == NOT_MERGED) {
+    for c in (0..columns.len()).filter(|&c| columns.merged_into(c).is_none()) {
         ending.entry(columns.node[c]).or_default().push(c);
     }
     ending
