@@ -175,20 +175,19 @@ mod tests {
     /// edge, only when folded flat onto each other; sharing nothing, when they intersect.
     #[test]
     fn triangles_meet_beyond_what_they_share() {
-        let p = |x: f64, y: f64, z: f64| DVec3::new(x, y, z);
-        let t = [p(0.0, 0.0, 0.0), p(1.0, 0.0, 0.0), p(0.0, 1.0, 0.0)];
+        let t = [v(0.0, 0.0, 0.0), v(1.0, 0.0, 0.0), v(0.0, 1.0, 0.0)];
         // Sharing vertex 0: lifted apart, then dipping through t.
-        let apart = [p(0.0, 0.0, 0.0), p(-1.0, 0.0, 0.5), p(0.0, -1.0, 0.5)];
-        let through = [p(0.0, 0.0, 0.0), p(0.5, 0.2, -0.5), p(0.2, 0.5, 0.5)];
+        let apart = [v(0.0, 0.0, 0.0), v(-1.0, 0.0, 0.5), v(0.0, -1.0, 0.5)];
+        let through = [v(0.0, 0.0, 0.0), v(0.5, 0.2, -0.5), v(0.2, 0.5, 0.5)];
         assert!(!triangles_meet([0, 1, 2], t, [0, 3, 4], apart));
         assert!(triangles_meet([0, 1, 2], t, [0, 3, 4], through));
         // Sharing the edge (1, 2): across it, then folded onto t.
-        let across = [p(1.0, 0.0, 0.0), p(1.0, 1.0, 0.0), p(0.0, 1.0, 0.0)];
-        let folded = [p(1.0, 0.0, 0.0), p(0.2, 0.2, 0.0), p(0.0, 1.0, 0.0)];
+        let across = [v(1.0, 0.0, 0.0), v(1.0, 1.0, 0.0), v(0.0, 1.0, 0.0)];
+        let folded = [v(1.0, 0.0, 0.0), v(0.2, 0.2, 0.0), v(0.0, 1.0, 0.0)];
         assert!(!triangles_meet([0, 1, 2], t, [1, 5, 2], across));
         assert!(triangles_meet([0, 1, 2], t, [1, 5, 2], folded));
         // Nothing shared: a triangle piercing t.
-        let pierce = [p(0.2, 0.2, -1.0), p(0.3, 0.2, 1.0), p(0.2, 0.3, 1.0)];
+        let pierce = [v(0.2, 0.2, -1.0), v(0.3, 0.2, 1.0), v(0.2, 0.3, 1.0)];
         assert!(triangles_meet([0, 1, 2], t, [6, 7, 8], pierce));
     }
 

@@ -637,7 +637,7 @@ fn settle_slab(
         let invalid_cells =
             |plan: &SlabPlan, group: &[u32]| invalid_cells_around(plan, reshape, mesh, columns, front, group);
         if !matches!(sizes.adapt, Adapt::Off) {
-            let user = sizes.user(&plan.proposed, &columns.marching());
+            let user = sizes.user(&plan.proposed, &plan.moving);
             let limits = (&reshape.target[..], &user[..], k);
             let coarsening =
                 coarsen::collapse_short_edges(&mut plan, front, columns, limits, vetoed, |plan, group| {
