@@ -79,6 +79,7 @@ fn main() {
 struct Wall {
     surface: Surface,
     topology: Topology,
+    features: Features,
     normals: WallNormals,
     spec: Vec<Option<LayerSpec>>,
     size: f64,
@@ -102,11 +103,21 @@ impl Wall {
         };
         let spec = LayerSpec::resolve(&settings, size).expect("a valid layer spec");
         let spec = vec![Some(spec); surface.patch_names.len()];
-        Wall { surface, topology, normals, spec, size }
+        Wall { surface, topology, features, normals, spec, size }
     }
 
     fn layers(&self, adapt: Adapt) -> blmesh::layers::Layers {
-        build_layers(&self.surface, &self.topology, &self.normals, &self.spec, adapt, &[], &[], |_, _| {})
+        build_layers(
+            &self.surface,
+            &self.topology,
+            &self.features,
+            &self.normals,
+            &self.spec,
+            adapt,
+            &[],
+            &[],
+            |_, _| {},
+        )
     }
 }
 

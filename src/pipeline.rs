@@ -217,6 +217,7 @@ pub fn run(
     let stages = LayersAndCore {
         surface: &surface,
         topology: &topology,
+        features: &features,
         wall_normals: &wall_normals,
         patch_spec: &patch_spec,
         adapt,
@@ -273,6 +274,7 @@ pub fn run(
 struct LayersAndCore<'a> {
     surface: &'a Surface,
     topology: &'a Topology,
+    features: &'a Features,
     wall_normals: &'a normals::WallNormals,
     patch_spec: &'a [Option<LayerSpec>],
     adapt: Adapt<'a>,
@@ -397,6 +399,7 @@ impl LayersAndCore<'_> {
             let mut layered = layers::build_layers(
                 surface,
                 self.topology,
+                self.features,
                 self.wall_normals,
                 self.patch_spec,
                 self.adapt,

@@ -4,7 +4,11 @@
 use crate::config::LayerSpec;
 use crate::geometry::DVec3;
 use crate::normals::constraint::Slide;
+use std::collections::HashSet;
+
 use crate::normals::WallNormals;
+use crate::surface::features::{EdgeKind, Features};
+use crate::surface::topology::Topology;
 use crate::surface::Surface;
 
 /// Struct-of-arrays of columns: a wall vertex (or a fan copy of it) followed through the layers.
@@ -283,6 +287,8 @@ pub struct Front {
     pub wall_triangle: Vec<u32>,
     /// Wall triangles that have had a cell built on them.
     pub wall_raised: Vec<bool>,
+    /// The wall's ridge edges, as sorted pairs of wall vertices: the front keeps them.
+    wall_ridges: HashSet<[u32; 2]>,
     /// Faces around each column (CSR).
     column_face_offsets: Vec<u32>,
     column_faces: Vec<u32>,
@@ -311,6 +317,19 @@ impl Front {
                 self.wall_raised.resize(t + 1, false);
             }
         }
+    }
+
+    /// Take the wall's ridge edges from its `features`.
+    pub fn set_wall_ridges(&mut self, topology: &Topology, features: &Features) {
+        self.wall_ridges = (topology.edges.iter().zip(&features.edge_kind))
+            .filter(|(_, &kind)| kind != EdgeKind::Smooth)
+            .map(|(&[a, b], _)| [a.min(b), a.max(b)])
+            .collect();
+    }
+
+    /// Whether the wall edge between wall vertices `a` and `b` is a ridge.
+    pub fn is_wall_ridge(&self, a: u32, b: u32) -> bool {
+        self.wall_ridges.contains(&[a.min(b), a.max(b)])
     }
 
     /// Mark face `f` as moved (and its wall triangle as covered by a cell).

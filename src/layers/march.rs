@@ -351,7 +351,7 @@ pub fn march(
             Adapt::Wall | Adapt::Field(_) => {
                 let target = sizes.tangential(&proposed, &columns.marching());
                 let splits = split::propose(columns, front, &proposed, k, sizes, &target);
-                let swaps = swap::propose(columns, front, &proposed, &splits);
+                let swaps = swap::propose(columns, front, &proposed, &splits, k);
                 Reshape { splits, swaps, target }
             }
         };

@@ -31,6 +31,7 @@ use crate::mesh::VolumeMesh;
 use crate::normals::constraint::Slide;
 use crate::normals::WallNormals;
 use crate::sizing::wall::mean_edge_length_per_vertex;
+use crate::surface::features::Features;
 use crate::surface::topology::Topology;
 use crate::surface::Surface;
 use tuning::TUNING;
@@ -81,6 +82,7 @@ pub struct Layers {
 pub fn build_layers(
     surface: &Surface,
     topology: &Topology,
+    features: &Features,
     normals: &WallNormals,
     patch_spec: &[Option<LayerSpec>],
     adapt: Adapt,
@@ -89,7 +91,7 @@ pub fn build_layers(
     mut on_layer: impl FnMut(u32, u32),
 ) -> Layers {
     let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
-    let start = MarchStart { surface, topology, normals, patch_spec, adapt, caps };
+    let start = MarchStart { surface, topology, features, normals, patch_spec, adapt, caps };
     let mut fitted = vec![false; surface.points.len()];
     let mut marched = start.march(&fitted, &mut on_layer);
     // Stacks stopped short where the first layer is too tall for the wall's facets: march
@@ -187,6 +189,7 @@ pub fn build_layers(
 struct MarchStart<'a> {
     surface: &'a Surface,
     topology: &'a Topology,
+    features: &'a Features,
     normals: &'a WallNormals,
     patch_spec: &'a [Option<LayerSpec>],
     adapt: Adapt<'a>,
@@ -213,6 +216,7 @@ impl<'a> MarchStart<'a> {
         // The faces without layers never move: leave them out of the front.
         let layered = |p: u32| patch_spec.get(p as usize).copied().flatten().is_some();
         front.retain_patches(layered, columns.len());
+        front.set_wall_ridges(self.topology, self.features);
         let mut column_spec = column_specs(self.normals, &front, patch_spec);
         let requested = column_spec.clone();
         fit_first_heights_to_wall(surface, &columns, fitted, &mut column_spec);

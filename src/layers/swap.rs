@@ -4,7 +4,9 @@
 //! the triangles `(c, a, d)` and `(d, b, c)`. Along a concave ridge, where face columns merge
 //! into the ridge's, a face can end up with its three columns on the ridge: a sliver lying in
 //! the front's crease, which pinches it (the core then meets it with slivers); it is swapped
-//! with its neighbour across its long edge like a pair a split made.
+//! with its neighbour across its long edge like a pair a split made. A pair of the wall's own
+//! triangles is swapped once the march has made it worse shaped than the wall did (see
+//! [`propose`]).
 //!
 //! In the slab being built, the two cells over the pair become one polyhedron: the two bottom
 //! triangles with the old diagonal, the two top triangles with the new one, and the four lateral
@@ -105,13 +107,22 @@ impl Swaps {
     }
 }
 
-/// Propose swaps on the front with the tops at `proposed`: pairs of triangles of one patch whose
-/// four columns are alive and slide alike, one of them born by a split or the poor face reshaped
-/// by a merge (the wall's own triangles are never swapped: their first cells stay prisms on the
-/// wall), with no split on their edges,
-/// whose worst top angle is poor and would gain by the swap without folding; each column in one
-/// swap at most, the worst pairs first.
-pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], splits: &Splits) -> Swaps {
+/// Propose swaps for layer `k` on the front with the tops at `proposed`: pairs of triangles of
+/// one patch whose four columns are alive and slide alike, with no split on their edges, whose
+/// worst top angle is poor and would gain by the swap without folding; each column in one swap
+/// at most, the worst pairs first. A pair of the wall's own triangles (no column born by a
+/// split, no face reshaped by a merge) is swapped only from the second layer on (the first
+/// cells stay prisms on the wall), not across a ridge of the wall, and only when its worst top
+/// angle has become poorer than its worst wall angle by the swap's gain: the march, not the
+/// user's triangulation, made it poor (columns converging towards a bisector, a fan sweeping
+/// over the wall beside it).
+pub(super) fn propose(
+    columns: &Columns,
+    front: &Front,
+    proposed: &[DVec3],
+    splits: &Splits,
+    k: u32,
+) -> Swaps {
     let split_faces = splits.faces_with_splits(front.len());
     let reshaped = faces_reshaped_by_merges(columns, front);
     let (split_faces, reshaped) = (&split_faces, &reshaped);
@@ -145,12 +156,23 @@ pub(super) fn propose(columns: &Columns, front: &Front, proposed: &[DVec3], spli
                 if !four.iter().all(|&x| usable(x)) || c == d || front.are_neighbours(c, d) {
                     return None;
                 }
-                // The wall's own triangulation is the user's: only pairs a split made, or a merge
-                // reshaped, are swapped.
-                if four.iter().all(|&x| columns.born_at[x as usize] == 0) && !reshaped[f] {
+                // The wall's own pairs keep the user's triangulation unless the march has made
+                // them worse than the wall made them, never in the first layer (its cells stay
+                // prisms on the wall) and never across a ridge (the front keeps the wall's
+                // creases).
+                let wall_born = four.iter().all(|&x| columns.born_at[x as usize] == 0) && !reshaped[f];
+                let wall_vertex = |x: u32| columns.wall_vertex[x as usize];
+                if wall_born && (k < 2 || front.is_wall_ridge(wall_vertex(a), wall_vertex(b))) {
                     return None;
                 }
                 let old = gain(four.map(|x| proposed[x as usize]))?;
+                if wall_born {
+                    let [a, b, c, d] = four.map(|x| columns.base[x as usize]);
+                    let wall = triangle_min_angle(a, b, c).min(triangle_min_angle(b, a, d));
+                    if old * TUNING.adaptation.swap_gain >= wall {
+                        return None;
+                    }
+                }
                 Some((old, Swap { faces: [f as u32, g as u32], columns: four, enabled: true }))
             })
         })
