@@ -102,19 +102,29 @@ impl CoreFront {
     /// Put node `v` at `p`, with the apexes of its quads; `false` (and nothing moved) when a
     /// quad of it could not be capped there.
     fn move_node(&mut self, v: u32, p: DVec3) -> bool {
-        let old = self.points[v as usize];
-        self.points[v as usize] = p;
-        let quads = self.quads_at(v).to_vec();
-        let mut apexes = Vec::with_capacity(quads.len());
-        for &q in &quads {
-            match pyramid_apex(self.quads[q as usize].map(|n| self.points[n as usize])) {
-                Some(apex) => apexes.push(apex),
-                None => {
-                    self.points[v as usize] = old;
-                    return false;
-                }
-            }
+        self.move_nodes(&[(v, p)])
+    }
+
+    /// Move several nodes at once (`(node, position)`), their quads' apexes after all of them;
+    /// `false`, with nothing moved, when a quad at them has no cap.
+    fn move_nodes(&mut self, moves: &[(u32, DVec3)]) -> bool {
+        let old: Vec<DVec3> = moves.iter().map(|&(v, _)| self.points[v as usize]).collect();
+        for &(v, p) in moves {
+            self.points[v as usize] = p;
         }
+        let mut quads: Vec<u32> = moves.iter().flat_map(|&(v, _)| self.quads_at(v).iter().copied()).collect();
+        quads.sort_unstable();
+        quads.dedup();
+        let apexes: Option<Vec<DVec3>> = quads
+            .iter()
+            .map(|&q| pyramid_apex(self.quads[q as usize].map(|n| self.points[n as usize])))
+            .collect();
+        let Some(apexes) = apexes else {
+            for (&(v, _), &p) in moves.iter().zip(&old) {
+                self.points[v as usize] = p;
+            }
+            return false;
+        };
         for (&q, apex) in quads.iter().zip(apexes) {
             self.points[self.first_apex + q as usize] = apex;
         }
@@ -388,16 +398,31 @@ fn undo_crossing_moves(
             .filter(|v| moved.contains_key(v))
             .collect();
         undo.extend(moved.keys().copied().filter(|v| !cells_valid(front, &cells[v])));
-        undo.sort_unstable();
-        undo.dedup();
         if undo.is_empty() {
             break;
         }
+        undo.sort_unstable();
+        undo.dedup();
+        // A top whose quad would have no cap with another corner still moved goes back with
+        // that corner (the march's positions are cappable).
+        let back = |undo: &[u32]| -> Vec<(u32, DVec3)> { undo.iter().map(|v| (*v, moved[v].0)).collect() };
+        while !front.move_nodes(&back(&undo)) {
+            let quads = undo.iter().flat_map(|&v| front.quads_at(v).iter().copied());
+            let mut more: Vec<u32> = quads
+                .flat_map(|q| front.quads[q as usize])
+                .filter(|c| moved.contains_key(c) && !undo.contains(c))
+                .collect();
+            if more.is_empty() {
+                debug_assert!(false, "the march's positions were cappable");
+                break;
+            }
+            undo.append(&mut more);
+            undo.sort_unstable();
+            undo.dedup();
+        }
         undone += undo.len();
         for v in undo {
-            let (position, step) = moved.remove(&v).expect("a moved top");
-            let moves = front.move_node(v, position);
-            debug_assert!(moves, "the march's position was cappable");
+            let (_, step) = moved.remove(&v).expect("a moved top");
             columns.last_step[tops[&v]] = step;
         }
     }
@@ -535,5 +560,20 @@ mod tests {
         assert!(!front.move_node(2, DVec3::ZERO));
         assert_eq!(front.points[2], DVec3::new(2.0, 2.0, 0.0));
         assert_eq!(front.quad_corners_of_apexes([0, 1, front.first_apex as u32]), vec![0, 1, 2, 3]);
+    }
+
+    /// Two corners of a quad pulled along x together: taking one back alone would cross the
+    /// quad over itself (no cap), so an undo takes both back at once.
+    #[test]
+    fn corners_of_a_quad_go_back_together_where_one_alone_has_no_cap() {
+        let square = vec![DVec3::ZERO, DVec3::X, DVec3::new(1.0, 1.0, 0.0), DVec3::Y];
+        let mut front = CoreFront::new(square.clone(), Vec::new(), vec![[0, 1, 2, 3]]).unwrap();
+        let apex = front.points[front.first_apex];
+        assert!(front.move_nodes(&[(0, DVec3::new(2.0, 0.0, 0.0)), (1, DVec3::new(3.0, 0.0, 0.0))]));
+        assert!(!front.move_node(1, square[1]), "corner 1 back alone crosses the quad over itself");
+        assert_eq!(front.points[1], DVec3::new(3.0, 0.0, 0.0), "a refused move moves nothing");
+        assert!(front.move_nodes(&[(0, square[0]), (1, square[1])]));
+        assert_eq!(front.points[..4], square[..]);
+        assert!((front.points[front.first_apex] - apex).length() < 1e-12, "the apex is back too");
     }
 }
