@@ -1,11 +1,11 @@
 //! The marching front: columns (one per extrusion direction of a wall vertex) and the front
 //! faces over them (the wall triangles, plus the fan strips and corner patches of convex ridges).
 
+use std::collections::HashSet;
+
 use crate::config::LayerSpec;
 use crate::geometry::DVec3;
 use crate::normals::constraint::Slide;
-use std::collections::HashSet;
-
 use crate::normals::WallNormals;
 use crate::surface::features::{EdgeKind, Features};
 use crate::surface::topology::Topology;
